@@ -1,0 +1,77 @@
+//! Raw BVH throughput: closest-hit and occlusion rays per second on the bundled scenes, with the rays an
+//! integrator would trace (camera rays, then shadow segments from the hit points to points on the lights).
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use illumlab::math::{SampleRng, offset_ray_origin};
+use illumlab::scene::{EmitterSampler, LightSelection, Scene, load_scene};
+use std::hint::black_box;
+
+const RAYS: usize = 1 << 16;
+
+struct Workload {
+    primary: Vec<(Vec3, Vec3)>,
+    shadow: Vec<(Vec3, Vec3, f32)>,
+}
+
+fn workload(scene: &Scene) -> Workload {
+    let basis = scene.camera.basis();
+    let emitters = EmitterSampler::new(scene, LightSelection::Power).expect("scene has emitters");
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    let mut primary = Vec::with_capacity(RAYS);
+    let mut shadow = Vec::with_capacity(RAYS);
+    for i in 0..RAYS as u64 {
+        let mut rng = SampleRng::new(1, i, 0);
+        let (x, y) = ((i % w as u64) as u32, ((i / w as u64) % h as u64) as u32);
+        let dir = basis.direction(x, y, rng.uniform_2d());
+        primary.push((basis.eye(), dir));
+        if let Some(hit) = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY) {
+            let tri = &scene.triangles[hit.triangle as usize];
+            let n = if tri.n.dot(dir) < 0.0 { tri.n } else { -tri.n };
+            let p = offset_ray_origin(basis.eye() + dir * hit.t, n);
+            let s = emitters.sample(scene, rng.uniform(), rng.uniform_2d());
+            let d = s.point - p;
+            let dist = d.length();
+            if dist > 0.0 {
+                shadow.push((p, d / dist, dist * 0.999));
+            }
+        }
+    }
+    Workload { primary, shadow }
+}
+
+fn rays(c: &mut Criterion) {
+    for name in ["cornell-box", "veach-mis"] {
+        let scene = load_scene(name).expect("bundled scene loads");
+        let work = workload(&scene);
+        let mut group = c.benchmark_group(format!("rays/{name}"));
+        group.throughput(Throughput::Elements(work.primary.len() as u64));
+        group.bench_function("closest_hit", |b| {
+            b.iter(|| {
+                let mut hits = 0u32;
+                for &(o, d) in &work.primary {
+                    hits += scene.accel().closest_hit(o, d, f32::INFINITY).is_some() as u32;
+                }
+                black_box(hits)
+            })
+        });
+        group.throughput(Throughput::Elements(work.shadow.len() as u64));
+        group.bench_function("occluded", |b| {
+            b.iter(|| {
+                let mut blocked = 0u32;
+                for &(o, d, t) in &work.shadow {
+                    blocked += scene.accel().occluded(o, d, t) as u32;
+                }
+                black_box(blocked)
+            })
+        });
+        group.finish();
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
+    targets = rays
+}
+criterion_main!(benches);

@@ -1,0 +1,36 @@
+//! Samples per second of a full pass, per strategy, on the bundled scenes (one thread: the per-core rate).
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
+use illumlab::scene::{LightSelection, load_scene};
+
+fn strategies(c: &mut Criterion) {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
+    for name in ["cornell-box", "veach-mis"] {
+        let mut scene = load_scene(name).expect("bundled scene loads");
+        scene.camera.width = 128;
+        scene.camera.height = 128;
+        let mut group = c.benchmark_group(format!("pass/{name}"));
+        group.throughput(Throughput::Elements(128 * 128));
+        for strategy in Strategy::ALL {
+            let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed: 0 };
+            let renderer = Renderer::new(&scene, settings);
+            let mut film = Film::new(128, 128);
+            let mut first = 0;
+            group.bench_function(strategy.name(), |b| {
+                b.iter(|| {
+                    pool.install(|| renderer.render_pass(&mut film, first, 1, &|| false));
+                    first += 1;
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
+    targets = strategies
+}
+criterion_main!(benches);

@@ -1,0 +1,150 @@
+//! The headless command line: `render` and `strategies`.
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use illumlab::render::{Film, PassStats, RenderSettings, Renderer, Strategy, check_output_path, write_image};
+use illumlab::scene::{LightSelection, load_scene};
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+#[derive(Parser, Debug)]
+#[command(name = "illumlab", version, about = "Monte Carlo estimators of the scattering equation: render and measure")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene with one strategy to an EXR (linear) or PNG (sRGB) file.
+    Render(RenderArgs),
+    /// List the sampling strategies: name, then a one-line description.
+    Strategies,
+}
+
+#[derive(clap::Args, Debug)]
+pub struct RenderArgs {
+    /// A scene file (.toml, or a bare .obj) or the name of a bundled scene (default, cornell-box, veach-mis,
+    /// near-light).
+    pub scene: String,
+    /// Sampling strategy (see `illumlab strategies`).
+    #[arg(long, value_parser = parse_strategy)]
+    pub strategy: Strategy,
+    /// Samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: u32,
+    /// Seed of the random streams.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// How emitter sampling picks a triangle: uniform, area or power.
+    #[arg(long, value_parser = parse_light_selection, default_value = "power")]
+    pub light_selection: LightSelection,
+    /// Image size WxH, overriding the scene's camera.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Exposure in stops, for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub threads: Option<u32>,
+    /// Output file: .exr or .png.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+fn parse_strategy(s: &str) -> Result<Strategy, String> {
+    Strategy::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
+        format!("unknown strategy (one of: {})", names.join(", "))
+    })
+}
+
+fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
+    LightSelection::from_name(s).ok_or_else(|| "unknown light selection (one of: uniform, area, power)".to_string())
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or("expected WxH, e.g. 256x256")?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&v| (1..=16384).contains(&v));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err("width and height must be whole numbers from 1 to 16384".into()),
+    }
+}
+
+pub fn run(command: Command) -> Result<()> {
+    match command {
+        Command::Strategies => {
+            for s in Strategy::ALL {
+                println!("{:<10} {}", s.name(), s.description());
+            }
+            Ok(())
+        }
+        Command::Render(args) => render(args),
+    }
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    if !args.exposure.is_finite() {
+        bail!("--exposure must be a finite number of stops");
+    }
+    check_output_path(&args.output)?;
+    let mut scene = load_scene(&args.scene)?;
+    if let Some((w, h)) = args.size {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.name);
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .context("cannot start the worker threads")?;
+    let settings = RenderSettings { strategy: args.strategy, light_selection: args.light_selection, seed: args.seed };
+    let renderer = Renderer::new(&scene, settings);
+    let mut film = Film::new(scene.camera.width, scene.camera.height);
+
+    // Passes of a few samples each: the progress bar advances between them; the result does not depend on it.
+    let chunk = pass_size(args.spp, film.pixels.len());
+    let start = Instant::now();
+    let mut stats = PassStats::default();
+    let mut bar: Option<indicatif::ProgressBar> = None;
+    let mut done = 0;
+    while done < args.spp {
+        let count = chunk.min(args.spp - done);
+        stats += pool.install(|| renderer.render_pass(&mut film, done, count, &|| false));
+        done += count;
+        if bar.is_none() && start.elapsed() > Duration::from_secs(1) && done < args.spp {
+            let b = indicatif::ProgressBar::new(args.spp as u64).with_style(
+                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")
+                    .expect("valid template"),
+            );
+            bar = Some(b);
+        }
+        if let Some(b) = &bar {
+            b.set_position(done as u64);
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    write_image(&film, &args.output, args.exposure)?;
+    println!(
+        "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped -> {}",
+        args.spp,
+        seconds,
+        stats.samples as f64 / seconds / 1e6,
+        stats.rays as f64 / seconds / 1e6,
+        stats.non_finite,
+        args.output.display()
+    );
+    Ok(())
+}
+
+/// Samples per pixel per pass: about 2 M samples, so a pass takes some tens of milliseconds.
+fn pass_size(spp: u32, pixels: usize) -> u32 {
+    ((2_000_000 / pixels.max(1)) as u32).clamp(1, spp)
+}

@@ -1,0 +1,142 @@
+//! Passes over the image: every pixel takes the samples `first..first + count`, in order, each from its own
+//! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
+//! number of threads and any split into passes.
+
+use super::{Film, ShadingPoint, Strategy, estimate_direct};
+use crate::math::SampleRng;
+use crate::scene::{CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// What a render is a function of, besides the scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct RenderSettings {
+    pub strategy: Strategy,
+    pub light_selection: LightSelection,
+    pub seed: u64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { strategy: Strategy::Emitter, light_selection: LightSelection::Power, seed: 0 }
+    }
+}
+
+/// Counts from one or more passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PassStats {
+    /// Pixel samples taken (accepted + dropped).
+    pub samples: u64,
+    /// Rays traced: camera, BRDF and shadow rays.
+    pub rays: u64,
+    /// Non-finite samples dropped.
+    pub non_finite: u64,
+}
+
+impl std::ops::AddAssign for PassStats {
+    fn add_assign(&mut self, o: Self) {
+        self.samples += o.samples;
+        self.rays += o.rays;
+        self.non_finite += o.non_finite;
+    }
+}
+
+/// Renders a scene with fixed settings.
+pub struct Renderer<'a> {
+    scene: &'a Scene,
+    settings: RenderSettings,
+    emitters: Option<EmitterSampler>,
+    camera: CameraBasis,
+}
+
+impl<'a> Renderer<'a> {
+    pub fn new(scene: &'a Scene, settings: RenderSettings) -> Self {
+        Self {
+            scene,
+            settings,
+            emitters: EmitterSampler::new(scene, settings.light_selection),
+            camera: scene.camera.basis(),
+        }
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Adds samples `first..first + count` to every pixel of `film` (which must match the camera's size).
+    /// `cancelled` is polled once per row; when it returns true the pass stops early and leaves the film
+    /// partially updated (the caller discards it).
+    pub fn render_pass(
+        &self,
+        film: &mut Film,
+        first: u32,
+        count: u32,
+        cancelled: &(dyn Fn() -> bool + Sync),
+    ) -> PassStats {
+        let width = film.width;
+        assert_eq!((film.width, film.height), (self.scene.camera.width, self.scene.camera.height));
+        film.pixels
+            .par_chunks_mut(width as usize)
+            .enumerate()
+            .map(|(y, row)| {
+                let mut stats = PassStats::default();
+                if cancelled() {
+                    return stats;
+                }
+                for (x, acc) in row.iter_mut().enumerate() {
+                    let pixel = y as u64 * width as u64 + x as u64;
+                    for s in first..first + count {
+                        let mut rng = SampleRng::new(self.settings.seed, pixel, s as u64);
+                        let v = self.sample_pixel(x as u32, y as u32, &mut rng, &mut stats.rays);
+                        if v.is_finite() {
+                            acc.add(v);
+                        } else {
+                            stats.non_finite += 1;
+                        }
+                    }
+                    stats.samples += count as u64;
+                }
+                stats
+            })
+            .reduce(PassStats::default, |mut a, b| {
+                a += b;
+                a
+            })
+    }
+
+    /// One sample of pixel (x, y): `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface seen through a
+    /// uniformly jittered position in the pixel (box filter).
+    #[inline]
+    pub fn sample_pixel(&self, x: u32, y: u32, rng: &mut SampleRng, rays: &mut u64) -> Vec3 {
+        let dir = self.camera.direction(x, y, rng.uniform_2d());
+        let eye = self.camera.eye();
+        *rays += 1;
+        let Some(hit) = self.scene.accel().closest_hit(eye, dir, f32::INFINITY) else { return Vec3::ZERO };
+        let tri = &self.scene.triangles[hit.triangle as usize];
+        let p = hit_point(tri, eye, dir, hit.t);
+        let wo = -dir;
+        let material = &self.scene.materials[tri.material as usize];
+        let sp = ShadingPoint::new(p, tri.n, wo, material);
+        let emitted = self.scene.emitted(hit.triangle, wo);
+        emitted + estimate_direct(self.scene, &sp, self.settings.strategy, self.emitters.as_ref(), rng, rays)
+    }
+}
+
+/// The hit point from barycentrics on the triangle rather than `o + t·d`, whose error grows with the distance
+/// travelled (Ray Tracing Gems ch. 6): its error is then a few ULPs of the vertices.
+#[inline]
+fn hit_point(tri: &Triangle, o: Vec3, d: Vec3, t: f32) -> Vec3 {
+    let [v0, v1, v2] = tri.v;
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    let pvec = d.cross(e2);
+    let det = e1.dot(pvec);
+    if det.abs() < 1e-30 {
+        return o + d * t;
+    }
+    let inv = 1.0 / det;
+    let tvec = o - v0;
+    let b1 = tvec.dot(pvec) * inv;
+    let b2 = d.dot(tvec.cross(e1)) * inv;
+    let p = v0 + e1 * b1.clamp(0.0, 1.0) + e2 * b2.clamp(0.0, 1.0);
+    if p.is_finite() { p } else { o + d * t }
+}

@@ -1,0 +1,17 @@
+//! Phong BRDF sampling: choose the diffuse lobe with Pr = k_d/(k_d+k_s), else the cos^α lobe around ω_r; divide
+//! by the mixture density. Two uniforms per sample: the lobe-choosing one is rescaled and reused.
+
+use super::{DirectionSample, Target};
+use crate::math::SampleRng;
+use crate::render::ShadingPoint;
+
+pub const DESCRIPTION: &str = "Phong BRDF sampling: Bernoulli choice of diffuse or cos^α lobe, mixture pdf";
+pub const PDF: &str = "p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α,  Pr_d = k_d/(k_d+k_s)";
+
+#[inline]
+pub fn sample(sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+    let m = sp.material;
+    let wi = m.sample_brdf(sp.n, sp.wo, rng.uniform_2d())?;
+    let pdf = m.pdf_brdf(sp.n, sp.wo, wi);
+    Some(DirectionSample { wi, pdf, target: Target::Trace })
+}

@@ -1,0 +1,14 @@
+//! Pure (sample, pdf) pairs. Every warp `sample_x(u)` has its density `x_pdf(..)` beside it; the doc comment
+//! gives the density, the measure it is taken in, and the source. Random inputs are named `u`, in [0, 1)².
+
+mod discrete;
+mod hemisphere;
+mod phong_lobe;
+mod triangle;
+
+pub use discrete::DiscreteDistribution;
+pub use hemisphere::{
+    cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
+};
+pub use phong_lobe::{phong_lobe_pdf, phong_lobe_pdf_from_gap, sample_phong_lobe};
+pub use triangle::{sample_uniform_triangle, uniform_triangle_pdf_area};

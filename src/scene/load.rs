@@ -1,0 +1,209 @@
+//! Loading: scene file (TOML) → OBJ/MTL meshes (tobj) → [`Scene`]. Files are read through a [`Source`]: the
+//! file system, or the scenes compiled into the binary.
+
+use super::bundled::{self, BundledScene};
+use super::file::{MaterialOverride, MeshSpec, SceneFile};
+use super::{Camera, Material, Scene, SceneError};
+use glam::Vec3;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Where a scene's files come from.
+enum Source {
+    Dir(PathBuf),
+    Bundled(&'static BundledScene),
+}
+
+impl Source {
+    fn read(&self, rel: &Path) -> Result<String, SceneError> {
+        match self {
+            Source::Dir(dir) => {
+                let path = dir.join(rel);
+                std::fs::read_to_string(&path).map_err(|source| SceneError::Io { path, source })
+            }
+            Source::Bundled(scene) => scene.file(rel).map(str::to_owned).ok_or_else(|| SceneError::Io {
+                path: rel.to_path_buf(),
+                source: std::io::Error::new(std::io::ErrorKind::NotFound, "not in the bundled scene"),
+            }),
+        }
+    }
+}
+
+/// Loads `name_or_path`: a scene file (`.toml`), a bare `.obj` (framed by an automatic camera), or the name of a
+/// bundled scene.
+pub fn load_scene(name_or_path: &str) -> Result<Scene, SceneError> {
+    let path = Path::new(name_or_path);
+    if path.is_file() {
+        return load_scene_file(path);
+    }
+    if let Some(scene) = bundled::find(name_or_path) {
+        let toml_name = format!("{}.toml", scene.name);
+        return load_from(&Source::Bundled(scene), Path::new(&toml_name), scene.name);
+    }
+    if path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR) {
+        return Err(SceneError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    Err(SceneError::UnknownScene { name: name_or_path.to_string(), known: bundled::names().join(", ") })
+}
+
+/// Loads a scene file from disk (`.toml`, or `.obj` with an automatic camera).
+pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    let file_name = PathBuf::from(path.file_name().unwrap_or_default());
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("scene").to_string();
+    let source = Source::Dir(dir);
+    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
+        let spec = MeshSpec { obj: file_name.to_string_lossy().into_owned(), materials: BTreeMap::new() };
+        let mut meshes = Meshes::default();
+        meshes.load(&source, &spec)?;
+        let camera = auto_camera(&meshes.positions);
+        return meshes.into_scene(name, camera, path);
+    }
+    load_from(&source, &file_name, &name)
+}
+
+fn load_from(source: &Source, toml_path: &Path, name: &str) -> Result<Scene, SceneError> {
+    let text = source.read(toml_path)?;
+    let file =
+        SceneFile::parse(&text).map_err(|message| SceneError::Toml { path: toml_path.to_path_buf(), message })?;
+    let c = &file.camera;
+    let camera = Camera {
+        eye: c.eye.into(),
+        target: c.target.into(),
+        up: c.up.into(),
+        fov_y: c.fov_y,
+        width: c.width,
+        height: c.height,
+    };
+    camera.validate().map_err(|e| SceneError::Toml { path: toml_path.to_path_buf(), message: e.to_string() })?;
+    let mut meshes = Meshes::default();
+    for spec in &file.mesh {
+        meshes.load(source, spec)?;
+    }
+    meshes.into_scene(name.to_string(), camera, toml_path)
+}
+
+/// Triangles and materials gathered from the meshes of one scene.
+#[derive(Default)]
+struct Meshes {
+    positions: Vec<[Vec3; 3]>,
+    material_ids: Vec<u32>,
+    materials: Vec<Material>,
+    names: Vec<String>,
+    default_material: Option<u32>,
+}
+
+impl Meshes {
+    fn load(&mut self, source: &Source, spec: &MeshSpec) -> Result<(), SceneError> {
+        let obj_path = PathBuf::from(&spec.obj);
+        let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
+        let text = source.read(&obj_path)?;
+        let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
+        let options =
+            tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
+        let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |mtl| {
+            let mtl_path = obj_dir.join(mtl);
+            let result = source.read(&mtl_path).map_err(|e| e.to_string()).and_then(|t| {
+                tobj::load_mtl_buf(&mut t.as_bytes()).map_err(|e| format!("{}: {e}", mtl_path.display()))
+            });
+            match result {
+                Ok(ok) => Ok(ok),
+                Err(message) => {
+                    mtl_error.borrow_mut().get_or_insert(SceneError::Mtl { path: mtl_path, message });
+                    Err(tobj::LoadError::GenericFailure)
+                }
+            }
+        })
+        .map_err(|e| SceneError::Obj { path: obj_path.clone(), message: e.to_string() })?;
+        if let Some(e) = mtl_error.into_inner() {
+            return Err(e);
+        }
+        let materials = materials.map_err(|e| SceneError::Mtl { path: obj_path.clone(), message: e.to_string() })?;
+
+        for name in spec.materials.keys() {
+            if !materials.iter().any(|m| &m.name == name) {
+                let known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+                return Err(SceneError::Mesh {
+                    path: obj_path,
+                    message: format!(
+                        "override for material '{name}', which its MTL does not define (it has: {})",
+                        known.join(", ")
+                    ),
+                });
+            }
+        }
+        let base = self.materials.len() as u32;
+        for m in &materials {
+            self.materials.push(from_mtl(m, spec.materials.get(&m.name)));
+            self.names.push(m.name.clone());
+        }
+
+        for model in &models {
+            let mesh = &model.mesh;
+            if let Some(i) = mesh.positions.iter().position(|x| !x.is_finite()) {
+                return Err(SceneError::Mesh {
+                    path: obj_path,
+                    message: format!("vertex {} of object '{}' is not finite (NaN or infinity)", i / 3 + 1, model.name),
+                });
+            }
+            let material = match mesh.material_id {
+                Some(id) if id < materials.len() => base + id as u32,
+                _ => self.default_material(),
+            };
+            let vertex = |i: u32| {
+                let i = 3 * i as usize;
+                Vec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
+            };
+            for f in mesh.indices.chunks_exact(3) {
+                self.positions.push([vertex(f[0]), vertex(f[1]), vertex(f[2])]);
+                self.material_ids.push(material);
+            }
+        }
+        Ok(())
+    }
+
+    fn default_material(&mut self) -> u32 {
+        *self.default_material.get_or_insert_with(|| {
+            self.materials.push(Material::default());
+            self.names.push("(no material)".into());
+            self.materials.len() as u32 - 1
+        })
+    }
+
+    fn into_scene(self, name: String, camera: Camera, path: &Path) -> Result<Scene, SceneError> {
+        Scene::new(name, camera, &self.positions, &self.material_ids, self.materials, self.names).map_err(|e| match e {
+            SceneError::Invalid(message) => SceneError::Mesh { path: path.to_path_buf(), message },
+            other => other,
+        })
+    }
+}
+
+/// MTL → Phong: Kd → k_d, Ks → k_s, Ns → α, Ke → L_e; missing values are 0 (α: 1). Then the overrides.
+fn from_mtl(m: &tobj::Material, o: Option<&MaterialOverride>) -> Material {
+    let o = o.cloned().unwrap_or_default();
+    let v = |x: Option<[f32; 3]>| x.map(Vec3::from).unwrap_or(Vec3::ZERO);
+    Material {
+        kd: v(o.kd.or(m.diffuse)),
+        ks: v(o.ks.or(m.specular)),
+        alpha: o.alpha.or(m.shininess).unwrap_or(1.0),
+        emission: v(o.ke.or(m.emissive)),
+    }
+}
+
+/// A camera for a bare OBJ: looks at the bounding box's centre along −z from far enough to see all of it.
+fn auto_camera(positions: &[[Vec3; 3]]) -> Camera {
+    let (lo, hi) =
+        positions.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    let (centre, radius) = if lo.is_finite() && hi.is_finite() {
+        (0.5 * (lo + hi), (0.5 * (hi - lo).length()).max(1e-3))
+    } else {
+        (Vec3::ZERO, 1.0)
+    };
+    let fov_y = 40.0f32;
+    let distance = radius / (0.5 * fov_y.to_radians()).sin();
+    Camera { eye: centre + Vec3::new(0.0, 0.0, distance), target: centre, up: Vec3::Y, fov_y, width: 512, height: 512 }
+}

@@ -1,0 +1,128 @@
+//! Scenes: triangles with Phong materials, emissive triangles as area lights, a pinhole camera and a BVH.
+//! Loaded from a TOML scene file that lists OBJ/MTL meshes, or built directly (tests, analytic scenes).
+
+mod accel;
+mod bundled;
+mod camera;
+mod emitters;
+mod error;
+mod file;
+mod load;
+mod material;
+
+pub use accel::{Accel, Hit};
+pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
+pub use camera::{Camera, CameraBasis};
+pub use emitters::{EmitterSample, EmitterSampler, LightSelection};
+pub use error::SceneError;
+pub use file::{MaterialOverride, SceneFile};
+pub use load::{load_scene, load_scene_file};
+pub use material::Material;
+
+use glam::Vec3;
+
+/// A triangle with its unit geometric normal `n = normalize((v₁−v₀)×(v₂−v₀))` (counter-clockwise winding) and
+/// area. Emitters emit on the side `n` faces; other surfaces are two-sided.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    pub v: [Vec3; 3],
+    pub n: Vec3,
+    pub area: f32,
+    pub material: u32,
+}
+
+/// A loaded scene, ready to render.
+pub struct Scene {
+    pub name: String,
+    pub camera: Camera,
+    /// In BVH order: a hit's triangle id indexes this directly.
+    pub triangles: Vec<Triangle>,
+    pub materials: Vec<Material>,
+    pub material_names: Vec<String>,
+    /// Indices into `triangles` of the emissive triangles of non-zero area.
+    pub emitters: Vec<u32>,
+    /// Things the user should know that do not stop rendering (no emitter, non-energy-conserving material, …).
+    pub warnings: Vec<String>,
+    accel: Accel,
+}
+
+impl Scene {
+    /// Builds a scene from triangle positions and per-triangle material indices. Zero-area (degenerate)
+    /// triangles can neither be hit nor emit: they are dropped and counted in a warning.
+    pub fn new(
+        name: impl Into<String>,
+        camera: Camera,
+        positions: &[[Vec3; 3]],
+        material_ids: &[u32],
+        materials: Vec<Material>,
+        material_names: Vec<String>,
+    ) -> Result<Self, SceneError> {
+        camera.validate()?;
+        assert_eq!(positions.len(), material_ids.len(), "one material id per triangle");
+        let mut warnings = Vec::new();
+        for (i, m) in materials.iter().enumerate() {
+            let name = material_names.get(i).map(String::as_str).unwrap_or("?");
+            material::validate(m, name)?;
+            if m.exceeds_energy_conservation() {
+                warnings.push(format!(
+                    "material '{name}': k_d + k_s > 1 is not energy-conserving (it reflects more than it receives)"
+                ));
+            }
+        }
+        let mut kept = Vec::with_capacity(positions.len());
+        let mut kept_ids = Vec::with_capacity(positions.len());
+        for (tri, &m) in positions.iter().zip(material_ids) {
+            if tri.iter().any(|v| !v.is_finite()) {
+                return Err(SceneError::NonFinite("vertex position".into()));
+            }
+            if (m as usize) >= materials.len() {
+                return Err(SceneError::Invalid(format!("triangle uses material {m}, which does not exist")));
+            }
+            let cross = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+            if cross.length_squared() > 0.0 && cross.length_squared().is_finite() {
+                kept.push(*tri);
+                kept_ids.push(m);
+            }
+        }
+        let dropped = positions.len() - kept.len();
+        if dropped > 0 {
+            warnings.push(format!("{dropped} degenerate (zero-area) triangle(s) ignored"));
+        }
+        let (accel, order) = Accel::build(&kept);
+        let triangles: Vec<Triangle> = order
+            .iter()
+            .map(|&i| {
+                let v = kept[i as usize];
+                let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+                let len = cross.length();
+                Triangle { v, n: cross / len, area: 0.5 * len, material: kept_ids[i as usize] }
+            })
+            .collect();
+        let emitters: Vec<u32> = (0..triangles.len() as u32)
+            .filter(|&i| materials[triangles[i as usize].material as usize].is_emissive())
+            .collect();
+        if emitters.is_empty() {
+            warnings.push("the scene has no emitter: the image will be black".into());
+        }
+        Ok(Self { name: name.into(), camera, triangles, materials, material_names, emitters, warnings, accel })
+    }
+
+    #[inline]
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    #[inline]
+    pub fn material_of(&self, triangle: u32) -> &Material {
+        &self.materials[self.triangles[triangle as usize].material as usize]
+    }
+
+    /// Radiance emitted by triangle `t` towards direction `w` (pointing away from the triangle): L_e on the side
+    /// its normal faces, 0 behind it.
+    #[inline]
+    pub fn emitted(&self, t: u32, w: Vec3) -> Vec3 {
+        let tri = &self.triangles[t as usize];
+        let m = &self.materials[tri.material as usize];
+        if tri.n.dot(w) > 0.0 { m.emission } else { Vec3::ZERO }
+    }
+}
