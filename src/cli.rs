@@ -31,10 +31,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_strategy)]
     pub strategy: Strategy,
     /// Samples per pixel.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub spp: u32,
     /// Seed of the random streams.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
     /// How emitter sampling picks a triangle: uniform, area or power.
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
@@ -46,7 +46,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub threads: Option<u32>,
     /// Output file: .exr or .png.
     #[arg(short, long)]

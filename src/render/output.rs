@@ -15,7 +15,7 @@ pub enum OutputFormat {
 pub enum OutputError {
     #[error("output {}: unsupported extension (use .exr or .png)", .0.display())]
     Extension(PathBuf),
-    #[error("output {}: the folder {} does not exist", .0.display(), .1.display())]
+    #[error("output {}: {} is not an existing folder", .0.display(), .1.display())]
     NoFolder(PathBuf, PathBuf),
     #[error("output {}: cannot write: {}", .0.display(), .1)]
     Write(PathBuf, String),

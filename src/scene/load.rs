@@ -3,6 +3,7 @@
 
 use super::bundled::{self, BundledScene};
 use super::file::{MaterialOverride, MeshSpec, SceneFile};
+use super::material::validate;
 use super::{Camera, Material, Scene, SceneError};
 use glam::Vec3;
 use std::cell::RefCell;
@@ -20,11 +21,11 @@ impl Source {
         match self {
             Source::Dir(dir) => {
                 let path = dir.join(rel);
-                std::fs::read_to_string(&path).map_err(|source| SceneError::Io { path, source })
+                std::fs::read_to_string(&path).map_err(|cause| SceneError::Io { path, cause })
             }
             Source::Bundled(scene) => scene.file(rel).map(str::to_owned).ok_or_else(|| SceneError::Io {
                 path: rel.to_path_buf(),
-                source: std::io::Error::new(std::io::ErrorKind::NotFound, "not in the bundled scene"),
+                cause: std::io::Error::new(std::io::ErrorKind::NotFound, "not in the bundled scene"),
             }),
         }
     }
@@ -44,7 +45,7 @@ pub fn load_scene(name_or_path: &str) -> Result<Scene, SceneError> {
     if path.extension().is_some() || name_or_path.contains(std::path::MAIN_SEPARATOR) {
         return Err(SceneError::Io {
             path: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+            cause: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
         });
     }
     Err(SceneError::UnknownScene { name: name_or_path.to_string(), known: bundled::names().join(", ") })
@@ -59,7 +60,7 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
     if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj")) {
         let spec = MeshSpec { obj: file_name.to_string_lossy().into_owned(), materials: BTreeMap::new() };
         let mut meshes = Meshes::default();
-        meshes.load(&source, &spec)?;
+        meshes.load(&source, &spec, path)?;
         let camera = auto_camera(&meshes.positions);
         return meshes.into_scene(name, camera, path);
     }
@@ -82,7 +83,7 @@ fn load_from(source: &Source, toml_path: &Path, name: &str) -> Result<Scene, Sce
     camera.validate().map_err(|e| SceneError::Toml { path: toml_path.to_path_buf(), message: e.to_string() })?;
     let mut meshes = Meshes::default();
     for spec in &file.mesh {
-        meshes.load(source, spec)?;
+        meshes.load(source, spec, toml_path)?;
     }
     meshes.into_scene(name.to_string(), camera, toml_path)
 }
@@ -98,31 +99,34 @@ struct Meshes {
 }
 
 impl Meshes {
-    fn load(&mut self, source: &Source, spec: &MeshSpec) -> Result<(), SceneError> {
+    /// `scene_file` is named in errors about the overrides it wrote.
+    fn load(&mut self, source: &Source, spec: &MeshSpec, scene_file: &Path) -> Result<(), SceneError> {
         let obj_path = PathBuf::from(&spec.obj);
         let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
         let text = source.read(&obj_path)?;
         let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
+        let mtl_paths: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
         let options =
             tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
         let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |mtl| {
             let mtl_path = obj_dir.join(mtl);
-            let result = source.read(&mtl_path).map_err(|e| e.to_string()).and_then(|t| {
-                tobj::load_mtl_buf(&mut t.as_bytes()).map_err(|e| format!("{}: {e}", mtl_path.display()))
+            let result = source.read(&mtl_path).and_then(|t| {
+                check_mtl_colours(&t).map_err(|message| SceneError::Mtl { path: mtl_path.clone(), message })?;
+                tobj::load_mtl_buf(&mut t.as_bytes())
+                    .map_err(|e| SceneError::Mtl { path: mtl_path.clone(), message: e.to_string() })
             });
-            match result {
-                Ok(ok) => Ok(ok),
-                Err(message) => {
-                    mtl_error.borrow_mut().get_or_insert(SceneError::Mtl { path: mtl_path, message });
-                    Err(tobj::LoadError::GenericFailure)
-                }
-            }
+            mtl_paths.borrow_mut().push(mtl_path);
+            result.map_err(|e| {
+                mtl_error.borrow_mut().get_or_insert(e);
+                tobj::LoadError::GenericFailure
+            })
         })
         .map_err(|e| SceneError::Obj { path: obj_path.clone(), message: e.to_string() })?;
         if let Some(e) = mtl_error.into_inner() {
             return Err(e);
         }
         let materials = materials.map_err(|e| SceneError::Mtl { path: obj_path.clone(), message: e.to_string() })?;
+        let mtl_path = mtl_paths.into_inner().pop().unwrap_or_else(|| obj_path.clone());
 
         for name in spec.materials.keys() {
             if !materials.iter().any(|m| &m.name == name) {
@@ -138,7 +142,13 @@ impl Meshes {
         }
         let base = self.materials.len() as u32;
         for m in &materials {
-            self.materials.push(from_mtl(m, spec.materials.get(&m.name)));
+            // Bad values are reported against the file that wrote them: the MTL, or the scene file's override.
+            let blame =
+                |path: &Path, e: SceneError| SceneError::Mesh { path: path.to_path_buf(), message: e.to_string() };
+            validate(&from_mtl(m, None), &m.name).map_err(|e| blame(&mtl_path, e))?;
+            let material = from_mtl(m, spec.materials.get(&m.name));
+            validate(&material, &m.name).map_err(|e| blame(scene_file, e))?;
+            self.materials.push(material);
             self.names.push(m.name.clone());
         }
 
@@ -206,4 +216,18 @@ fn auto_camera(positions: &[[Vec3; 3]]) -> Camera {
     let fov_y = 40.0f32;
     let distance = radius / (0.5 * fov_y.to_radians()).sin();
     Camera { eye: centre + Vec3::new(0.0, 0.0, distance), target: centre, up: Vec3::Y, fov_y, width: 512, height: 512 }
+}
+
+/// tobj 4.0 panics on a colour line with fewer than three numbers; reject those first, with the line number.
+fn check_mtl_colours(text: &str) -> Result<(), String> {
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
+            let numbers: Vec<&str> = words.collect();
+            if numbers.len() != 3 || numbers.iter().any(|w| w.parse::<f32>().is_err()) {
+                return Err(format!("line {}: {key} needs three numbers", i + 1));
+            }
+        }
+    }
+    Ok(())
 }
