@@ -1,10 +1,9 @@
 //! The shading point: where the scattering integral is evaluated.
 
-use crate::math::Frame;
 use crate::scene::Material;
 use glam::Vec3;
 
-/// A surface point with its normal flipped to the side ω_o is on (surfaces are two-sided), and its local frame.
+/// A surface point with its normal flipped to the side ω_o is on (surfaces are two-sided).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadingPoint<'a> {
     pub p: Vec3,
@@ -12,7 +11,6 @@ pub struct ShadingPoint<'a> {
     pub n: Vec3,
     /// Unit direction towards the viewer.
     pub wo: Vec3,
-    pub frame: Frame,
     pub material: &'a Material,
 }
 
@@ -21,6 +19,6 @@ impl<'a> ShadingPoint<'a> {
     #[inline]
     pub fn new(p: Vec3, geometric_normal: Vec3, wo: Vec3, material: &'a Material) -> Self {
         let n = if geometric_normal.dot(wo) < 0.0 { -geometric_normal } else { geometric_normal };
-        Self { p, n, wo, frame: Frame::from_z(n), material }
+        Self { p, n, wo, material }
     }
 }

@@ -35,15 +35,12 @@ impl DiscreteDistribution {
         self.pmf.is_empty()
     }
 
-    /// Picks index i with probability `pmf(i)`; returns it, its probability and `u` rescaled to [0, 1) within
-    /// the chosen interval (so the same uniform can be reused).
+    /// Picks index i with probability `pmf(i)`; returns it and its probability.
     #[inline]
-    pub fn sample(&self, u: f32) -> (usize, f32, f32) {
+    pub fn sample(&self, u: f32) -> (usize, f32) {
         let u = u as f64;
         let i = (self.cdf.partition_point(|&c| c <= u) - 1).min(self.pmf.len() - 1);
-        let (lo, hi) = (self.cdf[i], self.cdf[i + 1]);
-        let remapped = (((u - lo) / (hi - lo)) as f32).clamp(0.0, crate::math::ONE_MINUS_EPSILON);
-        (i, self.pmf[i], remapped)
+        (i, self.pmf[i])
     }
 
     #[inline]
@@ -60,9 +57,9 @@ mod tests {
     fn zero_weights_are_never_picked() {
         let d = DiscreteDistribution::new(&[0.0, 1.0, 0.0, 3.0, 0.0]).unwrap();
         for k in 0..1000 {
-            let (i, p, r) = d.sample(k as f32 / 1000.0);
+            let (i, p) = d.sample(k as f32 / 1000.0);
             assert!(i == 1 || i == 3);
-            assert!(p > 0.0 && (0.0..1.0).contains(&r));
+            assert!(p > 0.0);
         }
         assert_eq!(d.sample(0.0).0, 1);
         assert_eq!(d.sample(0.999_999_94).0, 3);

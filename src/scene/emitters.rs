@@ -87,7 +87,7 @@ impl EmitterSampler {
     /// Picks Δ with `u_select` and a uniform point on it with `u_point`.
     #[inline]
     pub fn sample(&self, scene: &Scene, u_select: f32, u_point: Vec2) -> EmitterSample {
-        let (slot, p_delta, _) = self.distribution.sample(u_select);
+        let (slot, p_delta) = self.distribution.sample(u_select);
         let triangle = self.triangles[slot];
         let [a, b, c] = scene.triangles[triangle as usize].v;
         EmitterSample { triangle, point: sample_uniform_triangle(u_point, a, b, c), p_delta }

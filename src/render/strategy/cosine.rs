@@ -1,7 +1,7 @@
 //! Cosine-weighted hemisphere sampling: `p(ω) = (ω·n)/π`, so the estimator is `f_r L_i π`.
 
 use super::{DirectionSample, Target};
-use crate::math::SampleRng;
+use crate::math::{Frame, SampleRng};
 use crate::render::ShadingPoint;
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 
@@ -11,6 +11,6 @@ pub const PDF: &str = "p(ω) = (ω·n)/π";
 #[inline]
 pub fn sample(sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
     let local = sample_cosine_hemisphere(rng.uniform_2d());
-    let wi = sp.frame.to_world(local);
+    let wi = Frame::from_z(sp.n).to_world(local);
     Some(DirectionSample { wi, pdf: cosine_hemisphere_pdf(local.z), target: Target::Trace })
 }
