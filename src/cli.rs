@@ -16,6 +16,8 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
+    /// Open the viewer (the default without a subcommand).
+    View(ViewArgs),
     /// Render a scene with one strategy to an EXR (linear) or PNG (sRGB) file.
     Render(RenderArgs),
     /// List the sampling strategies: name, then a one-line description.
@@ -53,6 +55,27 @@ pub struct RenderArgs {
     pub output: PathBuf,
 }
 
+#[derive(clap::Args, Debug)]
+pub struct ViewArgs {
+    /// A scene file or bundled scene; the embedded default scene if absent.
+    pub scene: Option<String>,
+    #[arg(long, value_parser = parse_strategy, default_value = "emitter")]
+    pub strategy: Strategy,
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    pub seed: u64,
+    #[arg(long, value_parser = parse_light_selection, default_value = "power")]
+    pub light_selection: LightSelection,
+    /// Stop refining at this many samples per pixel.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
+    pub target_spp: Option<u32>,
+    /// Exposure in stops.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Image size WxH, overriding the scene's camera.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+}
+
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
     Strategy::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
@@ -82,6 +105,18 @@ pub fn run(command: Command) -> Result<()> {
             Ok(())
         }
         Command::Render(args) => render(args),
+        Command::View(args) if !args.exposure.is_finite() => bail!("--exposure must be a finite number of stops"),
+        Command::View(args) => illumlab::app::run(illumlab::app::ViewOptions {
+            scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),
+            settings: RenderSettings {
+                strategy: args.strategy,
+                light_selection: args.light_selection,
+                seed: args.seed,
+            },
+            target_spp: args.target_spp,
+            exposure: args.exposure,
+            size: args.size,
+        }),
     }
 }
 
@@ -147,4 +182,18 @@ fn render(args: RenderArgs) -> Result<()> {
 /// Samples per pixel per pass: about 2 M samples, so a pass takes some tens of milliseconds.
 fn pass_size(spp: u32, pixels: usize) -> u32 {
     ((2_000_000 / pixels.max(1)) as u32).clamp(1, spp)
+}
+
+impl Default for ViewArgs {
+    fn default() -> Self {
+        Self {
+            scene: None,
+            strategy: Strategy::Emitter,
+            seed: 0,
+            light_selection: LightSelection::Power,
+            target_spp: None,
+            exposure: 0.0,
+            size: None,
+        }
+    }
 }

@@ -10,11 +10,13 @@
 //!
 //! Layers, bottom up: [`math`] and [`sampling`] are pure and tested against closed forms; [`scene`] loads
 //! triangles, Phong materials, emissive triangles and a camera and builds the BVH; [`render`] runs the estimators
-//! over an image. Nothing here knows about the UI.
+//! over an image, and its [`render::worker`] refines an image in the background. Only [`app`], the egui/eframe
+//! viewer on top, knows about the UI.
 //!
 //! Conventions: `wo` points towards the viewer, `wi` towards the light; local frames have z = n; uniforms are
 //! named `u` and live in [0, 1); a density names its measure (`pdf_area`, `pdf_solid_angle`).
 
+pub mod app;
 pub mod math;
 pub mod render;
 pub mod sampling;

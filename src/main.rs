@@ -1,8 +1,8 @@
-//! `illumlab`: the command line. Until the viewer lands, no subcommand prints the help.
+//! `illumlab`: with no subcommand, the viewer; `render`, `strategies`: the headless command line.
 
 mod cli;
 
-use clap::{CommandFactory, Parser};
+use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -20,17 +20,11 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match cli.command {
-        None => {
-            let _ = cli::Cli::command().print_help();
-            ExitCode::SUCCESS
+    match cli::run(cli.command.unwrap_or(cli::Command::View(cli::ViewArgs::default()))) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
         }
-        Some(command) => match cli::run(command) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {:#}", e);
-                ExitCode::FAILURE
-            }
-        },
     }
 }

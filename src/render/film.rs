@@ -48,6 +48,15 @@ impl Film {
         Self { width, height, pixels: vec![PixelAccum::default(); width as usize * height as usize] }
     }
 
+    /// A film holding one sample per pixel with the given values (to write means that were computed elsewhere).
+    pub fn from_means(width: u32, height: u32, means: &[Vec3]) -> Self {
+        let mut film = Self::new(width, height);
+        for (p, m) in film.pixels.iter_mut().zip(means) {
+            p.add(*m);
+        }
+        film
+    }
+
     #[inline]
     pub fn pixel(&self, x: u32, y: u32) -> &PixelAccum {
         &self.pixels[y as usize * self.width as usize + x as usize]

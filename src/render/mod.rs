@@ -5,11 +5,13 @@ mod film;
 mod output;
 mod pass;
 mod shading;
+pub mod snapshot;
 pub mod strategy;
+pub mod worker;
 
 pub use estimator::estimate_direct;
 pub use film::{Film, PixelAccum};
-pub use output::{OutputFormat, check_output_path, write_image};
+pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;
 pub use strategy::{DirectionSample, Strategy, Target};

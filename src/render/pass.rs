@@ -4,7 +4,7 @@
 
 use super::{Film, ShadingPoint, Strategy, estimate_direct};
 use crate::math::SampleRng;
-use crate::scene::{CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
+use crate::scene::{Camera, CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -47,15 +47,22 @@ pub struct Renderer<'a> {
     settings: RenderSettings,
     emitters: Option<EmitterSampler>,
     camera: CameraBasis,
+    size: (u32, u32),
 }
 
 impl<'a> Renderer<'a> {
     pub fn new(scene: &'a Scene, settings: RenderSettings) -> Self {
+        Self::with_camera(scene, settings, &scene.camera)
+    }
+
+    /// Renders through another camera than the scene's (e.g. a low-resolution preview).
+    pub fn with_camera(scene: &'a Scene, settings: RenderSettings, camera: &Camera) -> Self {
         Self {
             scene,
             settings,
             emitters: EmitterSampler::new(scene, settings.light_selection),
-            camera: scene.camera.basis(),
+            camera: camera.basis(),
+            size: (camera.width, camera.height),
         }
     }
 
@@ -74,7 +81,7 @@ impl<'a> Renderer<'a> {
         cancelled: &(dyn Fn() -> bool + Sync),
     ) -> PassStats {
         let width = film.width;
-        assert_eq!((film.width, film.height), (self.scene.camera.width, self.scene.camera.height));
+        assert_eq!((film.width, film.height), self.size, "film and camera sizes differ");
         film.pixels
             .par_chunks_mut(width as usize)
             .enumerate()

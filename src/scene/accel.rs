@@ -13,6 +13,7 @@ use std::time::Duration;
 
 /// Acceleration structure over the scene's triangles, stored in the BVH's leaf order so that a hit's
 /// primitive id indexes them directly.
+#[derive(Clone)]
 pub struct Accel {
     bvh: Option<CwBvh>,
     tris: Vec<RtTriangle>,

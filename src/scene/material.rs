@@ -96,6 +96,18 @@ fn mirror_gap(n: Vec3, wo: Vec3, wi: Vec3) -> f32 {
     0.5 * (wi - wr).length_squared()
 }
 
+/// Rejects values the BRDF is not defined for; the error names the material and the field.
+pub(crate) fn validate(m: &Material, name: &str) -> Result<(), super::SceneError> {
+    let check = |what: &str, ok: bool| {
+        if ok { Ok(()) } else { Err(super::SceneError::Invalid(format!("material '{name}': {what}"))) }
+    };
+    let non_negative = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+    check("k_d (Kd) must be finite and ≥ 0", non_negative(m.kd))?;
+    check("k_s (Ks) must be finite and ≥ 0", non_negative(m.ks))?;
+    check("emitted radiance (Ke) must be finite and ≥ 0", non_negative(m.emission))?;
+    check("Phong exponent α (Ns) must be finite and ≥ 0", m.alpha.is_finite() && m.alpha >= 0.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -126,16 +138,4 @@ mod tests {
         assert!((f.x / ((1e6 + 1.0) / (2.0 * PI)) - 1.0).abs() < 1e-5);
         assert!((m.pdf_brdf(Vec3::Z, wo, wr) / f.x - 1.0).abs() < 1e-5);
     }
-}
-
-/// Rejects values the BRDF is not defined for; the error names the material and the field.
-pub(crate) fn validate(m: &Material, name: &str) -> Result<(), super::SceneError> {
-    let check = |what: &str, ok: bool| {
-        if ok { Ok(()) } else { Err(super::SceneError::Invalid(format!("material '{name}': {what}"))) }
-    };
-    let non_negative = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
-    check("k_d (Kd) must be finite and ≥ 0", non_negative(m.kd))?;
-    check("k_s (Ks) must be finite and ≥ 0", non_negative(m.ks))?;
-    check("emitted radiance (Ke) must be finite and ≥ 0", non_negative(m.emission))?;
-    check("Phong exponent α (Ns) must be finite and ≥ 0", m.alpha.is_finite() && m.alpha >= 0.0)
 }

@@ -32,6 +32,7 @@ pub struct Triangle {
 }
 
 /// A loaded scene, ready to render.
+#[derive(Clone)]
 pub struct Scene {
     pub name: String,
     pub camera: Camera,
@@ -115,6 +116,13 @@ impl Scene {
     #[inline]
     pub fn material_of(&self, triangle: u32) -> &Material {
         &self.materials[self.triangles[triangle as usize].material as usize]
+    }
+
+    /// The triangle seen through pixel (x, y)'s centre, if any.
+    pub fn pick(&self, x: u32, y: u32) -> Option<u32> {
+        let basis = self.camera.basis();
+        let dir = basis.direction(x, y, glam::Vec2::splat(0.5));
+        self.accel.closest_hit(basis.eye(), dir, f32::INFINITY).map(|h| h.triangle)
     }
 
     /// Radiance emitted by triangle `t` towards direction `w` (pointing away from the triangle): L_e on the side

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Runs the real viewer under Xvfb (Mesa's software Vulkan), waits for it to refine, and captures the window:
+# screenshots/viewer-<scene>-<strategy>.png for each bundled scene and a few strategies.
+# Needs: xvfb xauth mesa-vulkan-drivers libvulkan1 libegl1 libgl1-mesa-dri imagemagick (Debian).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release --quiet
+bin=$PWD/target/release/illumlab
+wait_s=${WAIT:-12}
+runtime=$(mktemp -d); chmod 700 "$runtime"; export XDG_RUNTIME_DIR=$runtime
+shoot() { # scene strategy exposure
+  local out="screenshots/viewer-$1-$2.png"
+  xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+    '$bin' view '$1' --strategy '$2' --exposure '$3' --target-spp 1024 & pid=\$!
+    sleep $wait_s
+    import -window root '$out'
+    kill \$pid; wait \$pid 2>/dev/null || true"
+  echo "$out"
+}
+shoot default emitter 0
+shoot cornell-box emitter 1
+shoot cornell-box cosine 1
+shoot veach-mis brdf 0
+shoot veach-mis emitter 0
+shoot near-light emitter -2

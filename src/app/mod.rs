@@ -1,0 +1,66 @@
+//! The interactive viewer: a thin egui/eframe shell over [`crate::render::worker`]. Only this module knows egui.
+
+mod controls;
+mod loader;
+mod orbit;
+mod shortcuts;
+mod status;
+mod viewer;
+mod viewport;
+
+pub use viewer::Viewer;
+
+/// What the window opens on.
+#[derive(Clone, Debug)]
+pub struct ViewOptions {
+    /// A bundled scene's name or a scene file.
+    pub scene: String,
+    pub settings: crate::render::RenderSettings,
+    pub target_spp: Option<u32>,
+    pub exposure: f32,
+    /// Image size, overriding the scene's camera.
+    pub size: Option<(u32, u32)>,
+}
+
+impl Default for ViewOptions {
+    fn default() -> Self {
+        Self {
+            scene: crate::scene::DEFAULT_SCENE.into(),
+            settings: Default::default(),
+            target_spp: None,
+            exposure: 0.0,
+            size: None,
+        }
+    }
+}
+
+/// Opens the window, already rendering.
+pub fn run(options: ViewOptions) -> anyhow::Result<()> {
+    let mut scene = crate::scene::load_scene(&options.scene)?;
+    if let Some((w, h)) = options.size {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    let native = eframe::NativeOptions {
+        renderer: eframe::Renderer::Wgpu,
+        viewport: egui::ViewportBuilder::default().with_inner_size([1280.0, 800.0]).with_title("illumlab"),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "illumlab",
+        native,
+        Box::new(move |cc| {
+            let mut viewer = Viewer::with_scene(std::sync::Arc::new(scene));
+            viewer.configure(options.settings, options.target_spp, options.exposure);
+            viewer.bind_repaint(cc.egui_ctx.clone());
+            Ok(Box::new(viewer))
+        }),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot open the window: {e}"))
+}
+
+impl eframe::App for Viewer {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        Viewer::ui(self, ui);
+    }
+}

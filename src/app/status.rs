@@ -1,0 +1,49 @@
+//! The status bar: progress and the measured rates.
+
+use super::viewer::Viewer;
+
+pub fn status_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+    ui.horizontal_wrapped(|ui| {
+        let Some(f) = v.frame.clone() else {
+            ui.label("starting…");
+            return;
+        };
+        let seconds = f.elapsed.as_secs_f64().max(1e-9);
+        if f.preview {
+            ui.label("preview (½ resolution, 1 spp)");
+        } else {
+            ui.label(format!("{} spp", f.spp));
+        }
+        ui.separator();
+        ui.label(format!("{} passes", f.passes));
+        ui.separator();
+        ui.label(format!("{:.2} s", f.elapsed.as_secs_f64()));
+        ui.separator();
+        ui.label(format!("{:.2} M samples/s", f.stats.samples as f64 / seconds / 1e6));
+        ui.separator();
+        ui.label(format!("{:.2} M rays/s", f.stats.rays as f64 / seconds / 1e6));
+        ui.separator();
+        let dropped = format!("{} non-finite dropped", f.stats.non_finite);
+        if f.stats.non_finite > 0 {
+            ui.colored_label(ui.visuals().warn_fg_color, dropped);
+        } else {
+            ui.label(dropped);
+        }
+        ui.separator();
+        ui.label(format!("{}×{}", f.width, f.height));
+        if let Some(l) = v.restart_latency {
+            ui.separator();
+            ui.label(format!("restart to frame {:.0} ms", l.as_secs_f64() * 1e3));
+        }
+        if !v.ui_frame_times.is_empty() {
+            let mut t: Vec<_> = v.ui_frame_times.clone();
+            t.sort();
+            ui.separator();
+            ui.label(format!("UI {:.1} ms", t[t.len() / 2].as_secs_f64() * 1e3));
+        }
+        if v.paused {
+            ui.separator();
+            ui.strong("paused");
+        }
+    });
+}

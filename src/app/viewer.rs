@@ -1,0 +1,328 @@
+//! The viewer's state and its frame: take the newest frame from the worker, draw the panels, send what changed.
+
+use super::loader::Loading;
+use super::orbit;
+use crate::render::snapshot::{display_rgba, write_snapshot};
+use crate::render::worker::{Command, Frame, Worker};
+use crate::render::{RenderSettings, Strategy};
+use crate::scene::{Camera, Material, Scene};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Everything the UI shows and edits. The film itself lives in the worker.
+pub struct Viewer {
+    pub(super) worker: Worker,
+    /// Where the worker's `notify` sends repaint requests, once a context is known.
+    repaint: Arc<Mutex<Option<egui::Context>>>,
+    /// The UI's copy of the scene: names, materials, and geometry for picking under the cursor.
+    pub(super) scene: Arc<Scene>,
+    /// The scene file's camera: double-click returns to it.
+    pub(super) home_camera: Camera,
+    pub(super) camera: Camera,
+    pub(super) settings: RenderSettings,
+    pub(super) spp_per_pass: u32,
+    pub(super) target_spp: Option<u32>,
+    pub(super) paused: bool,
+    pub(super) exposure: f32,
+    pub(super) one_to_one: bool,
+    pub(super) selected_material: usize,
+    pub(super) frame: Option<Arc<Frame>>,
+    texture: Option<egui::TextureHandle>,
+    /// The texture must be refilled (new frame or new exposure).
+    texture_stale: bool,
+    pub(super) loading: Option<Loading>,
+    pub(super) error: Option<String>,
+    pub(super) message: Option<String>,
+    pub(super) open_path: String,
+    pub(super) export_folder: String,
+    pub(super) show_help: bool,
+    pub(super) hide_panels: bool,
+    /// When the last restart was requested, and the generation that answers it.
+    restart_sent: Option<(Instant, u64)>,
+    /// Time from the last restart request to its first frame on screen.
+    pub(super) restart_latency: Option<Duration>,
+    /// Recent UI frame times (for the status bar).
+    pub(super) ui_frame_times: Vec<Duration>,
+    /// `ILLUMLAB_TRACE` set: print latencies and frame times on stderr (for scripts/measure-viewer.sh).
+    trace: bool,
+    /// Start of the previous UI frame and the recent intervals between frames (painting included).
+    last_ui_start: Option<Instant>,
+    ui_intervals: Vec<Duration>,
+}
+
+impl Viewer {
+    pub fn with_scene(scene: Arc<Scene>) -> Self {
+        let repaint: Arc<Mutex<Option<egui::Context>>> = Arc::new(Mutex::new(None));
+        let target = repaint.clone();
+        let notify = move || {
+            if let Ok(ctx) = target.lock()
+                && let Some(ctx) = ctx.as_ref()
+            {
+                ctx.request_repaint();
+            }
+        };
+        // Leave the UI thread a core: on two cores the passes run on one.
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1));
+        let settings = RenderSettings::default();
+        let worker = Worker::spawn(scene.clone(), settings, threads, notify);
+        let camera = scene.camera;
+        let mut viewer = Self {
+            worker,
+            repaint,
+            home_camera: camera,
+            camera,
+            scene,
+            settings,
+            spp_per_pass: 1,
+            target_spp: None,
+            paused: false,
+            exposure: 0.0,
+            one_to_one: false,
+            selected_material: 0,
+            frame: None,
+            texture: None,
+            texture_stale: false,
+            loading: None,
+            error: None,
+            message: None,
+            open_path: String::new(),
+            export_folder: "screenshots".into(),
+            show_help: false,
+            hide_panels: false,
+            restart_sent: None,
+            restart_latency: None,
+            ui_frame_times: Vec::new(),
+            trace: std::env::var_os("ILLUMLAB_TRACE").is_some(),
+            last_ui_start: None,
+            ui_intervals: Vec::new(),
+        };
+        viewer.note_restart();
+        viewer
+    }
+
+    /// Sets strategy, light selection, seed, target and exposure (as the `view` command line does).
+    pub fn configure(&mut self, settings: RenderSettings, target_spp: Option<u32>, exposure: f32) {
+        self.settings = settings;
+        self.target_spp = target_spp;
+        self.set_exposure(exposure);
+        self.send_restarting(Command::SetSettings(settings));
+        self.send_spp();
+    }
+
+    /// The newest frame shown.
+    pub fn frame(&self) -> Option<&Frame> {
+        self.frame.as_deref()
+    }
+
+    /// The scene the UI is showing (the last one that loaded successfully).
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The error on display, if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// Where screenshots go.
+    pub fn set_export_folder(&mut self, folder: impl Into<String>) {
+        self.export_folder = folder.into();
+    }
+
+    /// True while a scene is loading in the background.
+    pub fn is_loading(&self) -> bool {
+        self.loading.is_some()
+    }
+
+    /// Lets the worker wake this context when a frame is ready.
+    pub fn bind_repaint(&self, ctx: egui::Context) {
+        if let Ok(mut slot) = self.repaint.lock() {
+            *slot = Some(ctx);
+        }
+    }
+
+    /// The whole UI for one frame (eframe's `App::ui` calls this; tests drive it through egui_kittest).
+    pub fn ui(&mut self, ui: &mut egui::Ui) {
+        let start = Instant::now();
+        if let Some(last) = self.last_ui_start.replace(start) {
+            self.ui_intervals.push(start - last);
+        }
+        if self.repaint.lock().is_ok_and(|c| c.is_none()) {
+            self.bind_repaint(ui.ctx().clone());
+        }
+        self.poll_loading();
+        self.take_frame();
+        super::shortcuts::handle(self, ui);
+        if !self.hide_panels {
+            egui::Panel::bottom("status").show(ui, |ui| super::status::status_ui(self, ui));
+            egui::Panel::left("controls").resizable(true).default_size(300.0).show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| super::controls::controls_ui(self, ui));
+            });
+        }
+        egui::CentralPanel::default().show(ui, |ui| super::viewport::viewport_ui(self, ui));
+        super::shortcuts::help_window(self, ui);
+        if self.loading.is_some() || self.frame.is_none() {
+            ui.ctx().request_repaint_after(Duration::from_millis(30));
+        }
+        self.ui_frame_times.push(start.elapsed());
+        if self.ui_frame_times.len() >= 120 {
+            if self.trace {
+                let mut t = self.ui_frame_times.clone();
+                t.sort();
+                let ms = |d: Duration| d.as_secs_f64() * 1e3;
+                eprintln!("trace: ui-frame median {:.2} ms, max {:.2} ms", ms(t[t.len() / 2]), ms(t[t.len() - 1]));
+                let mut i = std::mem::take(&mut self.ui_intervals);
+                i.sort();
+                if !i.is_empty() {
+                    eprintln!("trace: frame-interval median {:.2} ms, min {:.2} ms", ms(i[i.len() / 2]), ms(i[0]));
+                }
+            }
+            self.ui_frame_times.clear();
+        }
+    }
+
+    /// The newest frame from the worker, if any; refreshes the texture lazily.
+    fn take_frame(&mut self) {
+        if let Some(frame) = self.worker.take_frame() {
+            if let Some((sent, generation)) = self.restart_sent
+                && frame.generation >= generation
+            {
+                self.restart_latency = Some(sent.elapsed());
+                self.restart_sent = None;
+                if self.trace {
+                    let ms = sent.elapsed().as_secs_f64() * 1e3;
+                    eprintln!("trace: restart-to-frame {ms:.1} ms at {}x{}", frame.width, frame.height);
+                }
+            }
+            self.frame = Some(frame);
+            self.texture_stale = true;
+        }
+    }
+
+    /// The texture showing the current frame at the current exposure, updated in place.
+    pub(super) fn texture(&mut self, ctx: &egui::Context) -> Option<&egui::TextureHandle> {
+        let frame = self.frame.as_ref()?;
+        if self.texture_stale || self.texture.is_none() {
+            let size = [frame.width as usize, frame.height as usize];
+            let image = egui::ColorImage::from_rgba_unmultiplied(size, &display_rgba(&frame.radiance, self.exposure));
+            match &mut self.texture {
+                Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+                None => self.texture = Some(ctx.load_texture("film", image, egui::TextureOptions::NEAREST)),
+            }
+            self.texture_stale = false;
+        }
+        self.texture.as_ref()
+    }
+
+    pub(super) fn set_exposure(&mut self, stops: f32) {
+        self.exposure = stops.clamp(-20.0, 20.0);
+        self.texture_stale = true;
+    }
+
+    /// Sends a command that restarts accumulation and starts timing its first frame.
+    pub(super) fn send_restarting(&mut self, command: Command) {
+        self.worker.send(command);
+        self.note_restart();
+    }
+
+    fn note_restart(&mut self) {
+        self.restart_sent = Some((Instant::now(), self.worker.generation()));
+    }
+
+    pub(super) fn set_strategy(&mut self, strategy: Strategy) {
+        if self.settings.strategy != strategy {
+            self.settings.strategy = strategy;
+            self.send_restarting(Command::SetSettings(self.settings));
+        }
+    }
+
+    pub(super) fn apply_settings(&mut self) {
+        self.send_restarting(Command::SetSettings(self.settings));
+    }
+
+    pub(super) fn set_camera(&mut self, camera: Camera) {
+        if camera.validate().is_ok() && camera != self.camera {
+            self.camera = camera;
+            Arc::make_mut(&mut self.scene).camera = camera;
+            self.send_restarting(Command::SetCamera(camera));
+        }
+    }
+
+    pub(super) fn reset_camera(&mut self) {
+        let home = Camera { width: self.camera.width, height: self.camera.height, ..self.home_camera };
+        self.set_camera(home);
+    }
+
+    pub(super) fn set_resolution(&mut self, long_side: u32) {
+        let c = orbit::with_long_side(&self.camera, &self.home_camera, long_side);
+        self.set_camera(c);
+    }
+
+    pub(super) fn set_material(&mut self, index: usize, material: Material) {
+        if let Some(m) = Arc::make_mut(&mut self.scene).materials.get_mut(index)
+            && *m != material
+        {
+            *m = material;
+            self.send_restarting(Command::SetMaterial { index, material });
+        }
+    }
+
+    pub(super) fn set_paused(&mut self, paused: bool) {
+        self.paused = paused;
+        self.worker.send(Command::Pause(paused));
+    }
+
+    pub(super) fn restart(&mut self) {
+        self.send_restarting(Command::Restart);
+    }
+
+    /// Starts loading a bundled scene or a file in the background; the current scene stays until it succeeds.
+    pub(super) fn open(&mut self, what: String) {
+        let repaint = self.repaint.clone();
+        self.loading = Some(Loading::start(what, move || {
+            if let Ok(ctx) = repaint.lock()
+                && let Some(ctx) = ctx.as_ref()
+            {
+                ctx.request_repaint();
+            }
+        }));
+        self.error = None;
+    }
+
+    fn poll_loading(&mut self) {
+        let Some(result) = self.loading.as_ref().and_then(Loading::poll) else { return };
+        self.loading = None;
+        match result {
+            Ok(scene) => {
+                self.home_camera = scene.camera;
+                self.camera = scene.camera;
+                self.selected_material = 0;
+                self.message = scene.warnings.first().map(|w| format!("{}: {w}", scene.name));
+                self.scene = Arc::new(scene);
+                self.send_restarting(Command::SetScene(self.scene.clone()));
+            }
+            Err(e) => self.error = Some(e.to_string()),
+        }
+    }
+
+    /// Writes PNG, EXR and JSON of the current frame; the outcome is shown, never fatal.
+    pub(super) fn screenshot(&mut self) {
+        let Some(frame) = self.frame.clone() else {
+            self.message = Some("nothing to save yet".into());
+            return;
+        };
+        match write_snapshot(&frame, &PathBuf::from(&self.export_folder), self.exposure) {
+            Ok(paths) => {
+                self.message = Some(format!("saved {} (+ .exr, .json)", paths.png.display()));
+                self.error = None;
+            }
+            Err(e) => self.error = Some(format!("screenshot not saved: {e}")),
+        }
+    }
+
+    pub(super) fn send_spp(&mut self) {
+        self.worker.send(Command::SetSppPerPass(self.spp_per_pass));
+        self.worker.send(Command::SetTargetSpp(self.target_spp));
+    }
+}

@@ -1,0 +1,154 @@
+//! The viewer, driven through egui_kittest (no window, no GPU): the controls reach the integrator, restarts are
+//! visible in the next frames, screenshots are written, and a broken scene file leaves the viewer usable.
+
+use egui::accesskit::Role;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use illumlab::app::Viewer;
+use illumlab::render::Strategy;
+use illumlab::scene::load_scene;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+fn viewer() -> Viewer {
+    let mut scene = load_scene("cornell-box").expect("bundled scene");
+    scene.camera.width = 48;
+    scene.camera.height = 48;
+    Viewer::with_scene(Arc::new(scene))
+}
+
+fn harness(v: Viewer) -> Harness<'static, Viewer> {
+    let mut h =
+        Harness::builder().with_size(egui::vec2(1200.0, 900.0)).build_ui_state(|ui, v: &mut Viewer| v.ui(ui), v);
+    h.step();
+    h
+}
+
+/// Steps the UI until `pred` holds (the worker renders concurrently); fails after 30 s.
+fn step_until(h: &mut Harness<'_, Viewer>, what: &str, pred: impl Fn(&Viewer) -> bool) {
+    let start = Instant::now();
+    while !pred(h.state()) {
+        assert!(start.elapsed() < Duration::from_secs(30), "timed out waiting for: {what}");
+        std::thread::sleep(Duration::from_millis(5));
+        h.step();
+    }
+}
+
+#[test]
+fn choosing_a_strategy_by_its_label_changes_the_render_and_restarts() {
+    let mut h = harness(viewer());
+    step_until(&mut h, "a few passes", |v| v.frame().is_some_and(|f| f.spp >= 4));
+    let before = h.state().frame().map(|f| (f.generation, f.spp)).expect("a frame");
+    assert_eq!(h.state().frame().map(|f| f.settings.strategy), Some(Strategy::Emitter));
+    h.get_by_label("2 cosine").click();
+    h.step();
+    step_until(&mut h, "a cosine frame", |v| v.frame().is_some_and(|f| f.settings.strategy == Strategy::Cosine));
+    let f = h.state().frame().expect("a frame");
+    assert!(f.generation > before.0, "a new generation");
+    assert!(f.spp < before.1 + 4, "accumulation restarted at {} spp", f.spp);
+}
+
+#[test]
+fn keyboard_chooses_strategies() {
+    let mut h = harness(viewer());
+    h.key_press(egui::Key::Num3);
+    h.step();
+    step_until(&mut h, "a brdf frame", |v| v.frame().is_some_and(|f| f.settings.strategy == Strategy::Brdf));
+}
+
+#[test]
+fn a_material_slider_change_restarts() {
+    let mut h = harness(viewer());
+    step_until(&mut h, "a few passes", |v| v.frame().is_some_and(|f| f.spp >= 4));
+    let before = h.state().frame().map(|f| f.generation).expect("a frame");
+    let alpha = h.state().scene().materials[0].alpha;
+    h.get_by_role_and_label(Role::Slider, "α").set_value_accesskit(500.0);
+    h.step();
+    assert_ne!(h.state().scene().materials[0].alpha, alpha, "the slider changed α");
+    step_until(&mut h, "a frame of the new generation", |v| v.frame().is_some_and(|f| f.generation > before));
+}
+
+#[test]
+fn the_screenshot_button_writes_png_exr_and_json() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut v = viewer();
+    v.set_export_folder(dir.path().join("shots").to_string_lossy().into_owned());
+    let mut h = harness(v);
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_by_label("Save screenshot (S)").click();
+    h.step();
+    let names: Vec<String> = std::fs::read_dir(dir.path().join("shots"))
+        .expect("the folder was created")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    for ext in ["png", "exr", "json"] {
+        assert!(
+            names.iter().any(|n| n.starts_with("cornell-box-emitter-") && n.ends_with(&format!("spp.{ext}"))),
+            "{ext} missing: {names:?}"
+        );
+    }
+    let json = names.iter().find(|n| n.ends_with(".json")).expect("sidecar");
+    let text = std::fs::read_to_string(dir.path().join("shots").join(json)).expect("readable");
+    for key in ["\"scene\"", "\"strategy\"", "\"spp\"", "\"seconds\"", "\"seed\"", "\"version\"", "\"camera\""] {
+        assert!(text.contains(key), "{key} missing from the sidecar");
+    }
+}
+
+#[test]
+fn an_unwritable_screenshot_folder_is_shown_not_fatal() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, "not a folder").expect("write");
+    let mut v = viewer();
+    v.set_export_folder(file.join("shots").to_string_lossy().into_owned());
+    let mut h = harness(v);
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_by_label("Save screenshot (S)").click();
+    h.step();
+    assert!(h.state().error().is_some_and(|e| e.contains("screenshot not saved")), "{:?}", h.state().error());
+    h.step();
+    assert!(h.query_by_label_contains("screenshot not saved").is_some(), "the error is on screen");
+}
+
+#[test]
+fn a_broken_scene_file_shows_an_error_and_the_previous_scene_stays_usable() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let broken = dir.path().join("broken.toml");
+    std::fs::write(&broken, "[camera]\neye = [0, 1, 2\n").expect("write");
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_by_label("file").focus();
+    h.step();
+    h.get_by_label("file").type_text(&broken.to_string_lossy());
+    h.step();
+    h.get_by_label("Open").click();
+    h.step();
+    step_until(&mut h, "loading to end", |v| !v.is_loading());
+    h.step();
+    let error = h.state().error().expect("an error").to_string();
+    assert!(error.contains("broken.toml"), "{error}");
+    assert!(h.query_by_label_contains("broken.toml").is_some(), "the error is on screen");
+    assert_eq!(h.state().scene().name, "cornell-box");
+    // Still rendering, and still controllable.
+    h.get_by_label("4 emitter").click();
+    h.get_by_label("1 uniform").click();
+    h.step();
+    step_until(&mut h, "a uniform frame", |v| v.frame().is_some_and(|f| f.settings.strategy == Strategy::Uniform));
+}
+
+#[test]
+fn choosing_a_bundled_scene_loads_it_in_the_background() {
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_all_by_role(Role::ComboBox)
+        .find(|n| n.value().as_deref() == Some("cornell-box"))
+        .expect("the scene picker shows the current scene")
+        .click();
+    // The popup opens on the frame after the click.
+    h.step();
+    h.step();
+    h.get_by_label("near-light").click();
+    h.step();
+    step_until(&mut h, "the near-light frame", |v| v.frame().is_some_and(|f| f.scene_name == "near-light"));
+    assert_eq!(h.state().scene().name, "near-light");
+}
