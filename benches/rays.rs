@@ -4,6 +4,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use illumlab::math::{SampleRng, offset_ray_origin};
+use illumlab::sampling::sample_uniform_triangle;
 use illumlab::scene::{EmitterSampler, LightSelection, Scene, load_scene};
 use std::hint::black_box;
 
@@ -29,8 +30,9 @@ fn workload(scene: &Scene) -> Workload {
             let tri = &scene.triangles[hit.triangle as usize];
             let n = if tri.n.dot(dir) < 0.0 { tri.n } else { -tri.n };
             let p = offset_ray_origin(basis.eye() + dir * hit.t, n);
-            let s = emitters.sample(scene, rng.uniform(), rng.uniform_2d());
-            let d = s.point - p;
+            let Some((t, _)) = emitters.pick(scene, p, rng.uniform()) else { continue };
+            let [a, b, c] = scene.triangles[t as usize].v;
+            let d = sample_uniform_triangle(rng.uniform_2d(), a, b, c) - p;
             let dist = d.length();
             if dist > 0.0 {
                 shadow.push((p, d / dist, dist * 0.999));

@@ -13,7 +13,8 @@ fn strategies(c: &mut Criterion) {
         let mut group = c.benchmark_group(format!("pass/{name}"));
         group.throughput(Throughput::Elements(128 * 128));
         for strategy in Strategy::ALL {
-            let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed: 0 };
+            let settings =
+                RenderSettings { strategy, light_selection: LightSelection::Power, seed: 0, ..Default::default() };
             let renderer = Renderer::new(&scene, settings);
             let mut film = Film::new(128, 128);
             let mut first = 0;

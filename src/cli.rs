@@ -2,7 +2,10 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
-use illumlab::render::{Film, PassStats, RenderSettings, Renderer, Strategy, check_output_path, write_image};
+use illumlab::render::{
+    Film, Heuristic, LightTechnique, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
+    write_image,
+};
 use illumlab::scene::{LightSelection, load_scene};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -38,7 +41,7 @@ pub struct RenderArgs {
     /// Seed of the random streams.
     #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
-    /// How emitter sampling picks a triangle: uniform, area or power.
+    /// How light strategies pick a triangle: uniform, area, power or contribution.
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
     pub light_selection: LightSelection,
     /// Image size WxH, overriding the scene's camera.
@@ -47,6 +50,8 @@ pub struct RenderArgs {
     /// Exposure in stops, for PNG output.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    #[command(flatten)]
+    pub mis: MisArgs,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub threads: Option<u32>,
@@ -74,6 +79,57 @@ pub struct ViewArgs {
     /// Image size WxH, overriding the scene's camera.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    #[command(flatten)]
+    pub mis: MisArgs,
+}
+
+/// The options of `--strategy mis`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct MisArgs {
+    /// MIS: the light strategy combined with BRDF sampling (emitter, solid-angle, projected-solid-angle).
+    #[arg(long, value_parser = parse_light_technique, default_value = "emitter")]
+    pub mis_light: LightTechnique,
+    /// MIS: balance or power heuristic.
+    #[arg(long, value_parser = parse_heuristic, default_value = "power")]
+    pub mis_heuristic: Heuristic,
+    /// MIS: light and BRDF samples per pixel sample, as L,B.
+    #[arg(long, value_parser = parse_mis_samples, default_value = "1,1")]
+    pub mis_samples: (u32, u32),
+}
+
+impl Default for MisArgs {
+    fn default() -> Self {
+        let m = MisSettings::default();
+        Self { mis_light: m.light, mis_heuristic: m.heuristic, mis_samples: (m.light_samples, m.brdf_samples) }
+    }
+}
+
+impl MisArgs {
+    fn settings(&self) -> MisSettings {
+        MisSettings {
+            light: self.mis_light,
+            heuristic: self.mis_heuristic,
+            light_samples: self.mis_samples.0,
+            brdf_samples: self.mis_samples.1,
+        }
+    }
+}
+
+fn parse_light_technique(s: &str) -> Result<LightTechnique, String> {
+    LightTechnique::from_name(s)
+        .ok_or_else(|| "unknown light strategy (one of: emitter, solid-angle, projected-solid-angle)".into())
+}
+
+fn parse_heuristic(s: &str) -> Result<Heuristic, String> {
+    Heuristic::from_name(s).ok_or_else(|| "unknown heuristic (balance or power)".into())
+}
+
+fn parse_mis_samples(s: &str) -> Result<(u32, u32), String> {
+    let (l, b) = s.split_once(',').ok_or("expected L,B, e.g. 1,1")?;
+    match (l.trim().parse::<u32>(), b.trim().parse::<u32>()) {
+        (Ok(l), Ok(b)) if l + b > 0 && l <= 1024 && b <= 1024 => Ok((l, b)),
+        _ => Err("L and B must be whole numbers up to 1024, not both 0".into()),
+    }
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
@@ -84,7 +140,8 @@ fn parse_strategy(s: &str) -> Result<Strategy, String> {
 }
 
 fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
-    LightSelection::from_name(s).ok_or_else(|| "unknown light selection (one of: uniform, area, power)".to_string())
+    LightSelection::from_name(s)
+        .ok_or_else(|| "unknown light selection (one of: uniform, area, power, contribution)".to_string())
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -100,7 +157,7 @@ pub fn run(command: Command) -> Result<()> {
     match command {
         Command::Strategies => {
             for s in Strategy::ALL {
-                println!("{:<10} {}", s.name(), s.description());
+                println!("{:<22} {}", s.name(), s.description());
             }
             Ok(())
         }
@@ -112,6 +169,7 @@ pub fn run(command: Command) -> Result<()> {
                 strategy: args.strategy,
                 light_selection: args.light_selection,
                 seed: args.seed,
+                mis: args.mis.settings(),
             },
             target_spp: args.target_spp,
             exposure: args.exposure,
@@ -137,7 +195,12 @@ fn render(args: RenderArgs) -> Result<()> {
         .num_threads(args.threads.unwrap_or(0) as usize)
         .build()
         .context("cannot start the worker threads")?;
-    let settings = RenderSettings { strategy: args.strategy, light_selection: args.light_selection, seed: args.seed };
+    let settings = RenderSettings {
+        strategy: args.strategy,
+        light_selection: args.light_selection,
+        seed: args.seed,
+        mis: args.mis.settings(),
+    };
     let renderer = Renderer::new(&scene, settings);
     let mut film = Film::new(scene.camera.width, scene.camera.height);
 
@@ -194,6 +257,7 @@ impl Default for ViewArgs {
             target_spp: None,
             exposure: 0.0,
             size: None,
+            mis: MisArgs::default(),
         }
     }
 }

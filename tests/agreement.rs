@@ -23,7 +23,7 @@ struct Region {
 }
 
 fn regions(scene: &Scene, strategy: Strategy, spp: u32, seed: u64) -> Vec<Region> {
-    let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed };
+    let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed, ..Default::default() };
     let renderer = Renderer::new(scene, settings);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut film = Film::new(w, h);

@@ -4,9 +4,11 @@
 
 mod common;
 
-use common::{any_camera, estimate_at, quad};
+use common::{any_camera, estimate_with, quad};
 use glam::Vec3;
-use illumlab::render::{Film, RenderSettings, Renderer, ShadingPoint, Strategy};
+use illumlab::render::{
+    Film, Heuristic, LightTechnique, MisSettings, RenderSettings, Renderer, ShadingPoint, Strategy,
+};
 use illumlab::scene::{Camera, LightSelection, Material, Scene};
 
 const ALPHAS: [f32; 5] = [0.0, 1e-3, 1.0, 1e3, 1e6];
@@ -54,6 +56,23 @@ fn scene(camera: Camera) -> Scene {
     scene
 }
 
+/// Every strategy with every light selection, and MIS with every light technique and heuristic.
+fn all_settings() -> Vec<RenderSettings> {
+    let mut out = Vec::new();
+    for selection in LightSelection::ALL {
+        for strategy in Strategy::ALL.into_iter().filter(|s| *s != Strategy::Mis) {
+            out.push(RenderSettings { strategy, light_selection: selection, seed: 5, ..Default::default() });
+        }
+        for light in LightTechnique::ALL {
+            for heuristic in Heuristic::ALL {
+                let mis = MisSettings { light, heuristic, light_samples: 2, brdf_samples: 1 };
+                out.push(RenderSettings { strategy: Strategy::Mis, light_selection: selection, seed: 5, mis });
+            }
+        }
+    }
+    out
+}
+
 #[test]
 fn every_strategy_is_finite_at_the_extremes() {
     let scene = scene(any_camera());
@@ -76,17 +95,15 @@ fn every_strategy_is_finite_at_the_extremes() {
         let n = if p.y >= 1.0 - 1e-3 { -Vec3::Y } else { Vec3::Y };
         for m in &materials {
             let sp = ShadingPoint::new(p, n, wo, m);
-            for strategy in Strategy::ALL {
-                for selection in LightSelection::ALL {
-                    let e = estimate_at(&scene, &sp, strategy, selection, 256, 5);
-                    assert_eq!(e.non_finite, 0, "{label}, α = {}, {}: non-finite samples", m.alpha, strategy.name());
-                    assert!(e.mean.is_finite() && e.mean.min_element() >= 0.0, "{label}: mean {:?}", e.mean);
-                    checked += 1;
-                }
+            for settings in all_settings() {
+                let e = estimate_with(&scene, &sp, &settings, 64);
+                assert_eq!(e.non_finite, 0, "{label}, α = {}, {settings:?}: non-finite samples", m.alpha);
+                assert!(e.mean.is_finite() && e.mean.min_element() >= 0.0, "{label}: mean {:?}", e.mean);
+                checked += 1;
             }
         }
     }
-    assert_eq!(checked, 8 * 25 * 4 * 3);
+    assert_eq!(checked, 8 * 25 * all_settings().len());
 }
 
 #[test]
@@ -113,12 +130,11 @@ fn renders_of_extreme_scenes_drop_nothing() {
     ];
     for camera in cameras {
         let scene = scene(camera);
-        for strategy in Strategy::ALL {
-            let renderer =
-                Renderer::new(&scene, RenderSettings { strategy, light_selection: LightSelection::Power, seed: 1 });
+        for settings in all_settings() {
+            let renderer = Renderer::new(&scene, settings);
             let mut film = Film::new(camera.width, camera.height);
-            let stats = renderer.render_pass(&mut film, 0, 16, &|| false);
-            assert_eq!(stats.non_finite, 0, "{}: non-finite samples", strategy.name());
+            let stats = renderer.render_pass(&mut film, 0, 2, &|| false);
+            assert_eq!(stats.non_finite, 0, "{settings:?}: non-finite samples");
             assert!(film.means().iter().all(|c| c.is_finite() && c.min_element() >= 0.0));
         }
     }

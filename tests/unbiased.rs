@@ -1,14 +1,16 @@
 //! Unbiasedness: on a diffuse floor under polygonal lights with no occluders, every strategy's mean equals the
 //! closed form `L_o = k_d/π · E`, with Lambert's polygon irradiance `E = L/2 Σ Θ_i (n·γ_i)`, within 4 standard
-//! errors. Fixed seeds: deterministic. For a fresh seed, each comparison fails with probability 6.3·10⁻⁵ (normal
-//! approximation); this file makes 24 independent ones, so a correct estimator fails it with probability ≈ 0.15%.
+//! errors. Fixed seeds: deterministic. For a fresh seed, each comparison (one strategy at one point) fails with
+//! probability ≤ 3 × 6.3·10⁻⁵ (normal approximation, three channels); this file makes 75 of them, so a correct
+//! estimator fails it with probability ≲ 1.4%. Projected-solid-angle sampling is also checked for the zero
+//! variance it must have under a single unoccluded triangle.
 
 mod common;
 
-use common::{any_camera, estimate_at};
+use common::{any_camera, estimate_with};
 use glam::{DVec3, Vec3};
 use illumlab::math::lambert_polygon_irradiance;
-use illumlab::render::{ShadingPoint, Strategy};
+use illumlab::render::{Heuristic, LightTechnique, MisSettings, RenderSettings, ShadingPoint, Strategy};
 use illumlab::scene::{LightSelection, Material, Scene};
 use std::f64::consts::PI;
 
@@ -70,6 +72,12 @@ fn closed_form(s: &Setup, p: DVec3) -> DVec3 {
 }
 
 fn check(strategy: Strategy, selection: LightSelection, samples: u64) {
+    let far = if strategy.light_technique().is_some() { samples } else { samples * 64 };
+    check_with(RenderSettings { strategy, light_selection: selection, ..Default::default() }, samples, far);
+}
+
+fn check_with(settings: RenderSettings, samples: u64, far_samples: u64) {
+    let (strategy, selection) = (settings.strategy, settings.light_selection);
     let s = setup();
     let wo = Vec3::new(0.3, 0.8, -0.2).normalize();
     let points = [
@@ -80,8 +88,8 @@ fn check(strategy: Strategy, selection: LightSelection, samples: u64) {
     for (i, (label, p)) in points.into_iter().enumerate() {
         let material = &s.scene.materials[0];
         let sp = ShadingPoint::new(p, Vec3::Y, wo, material);
-        let n = if i == 2 { samples * 64 } else { samples };
-        let est = estimate_at(&s.scene, &sp, strategy, selection, n, 100 + i as u64);
+        let n = if i == 2 { far_samples } else { samples };
+        let est = estimate_with(&s.scene, &sp, &RenderSettings { seed: 100 + i as u64, ..settings }, n);
         let expected = closed_form(&s, p.as_dvec3());
         let z = (est.mean - expected).abs() / est.std_error;
         eprintln!(
@@ -128,4 +136,77 @@ fn emitter_area_selection_is_unbiased() {
 #[test]
 fn emitter_power_selection_is_unbiased() {
     check(Strategy::Emitter, LightSelection::Power, 100_000);
+}
+
+#[test]
+fn emitter_contribution_selection_is_unbiased() {
+    check(Strategy::Emitter, LightSelection::Contribution, 100_000);
+}
+
+#[test]
+fn solid_angle_is_unbiased_for_every_light_selection() {
+    for selection in LightSelection::ALL {
+        check(Strategy::SolidAngle, selection, 100_000);
+    }
+}
+
+#[test]
+fn projected_solid_angle_is_unbiased_for_every_light_selection() {
+    for selection in LightSelection::ALL {
+        check(Strategy::ProjectedSolidAngle, selection, 100_000);
+    }
+}
+
+#[test]
+fn mis_is_unbiased_for_every_light_technique_and_heuristic() {
+    for light in LightTechnique::ALL {
+        for heuristic in Heuristic::ALL {
+            for (light_samples, brdf_samples) in [(1, 1), (3, 1)] {
+                let mis = MisSettings { light, heuristic, light_samples, brdf_samples };
+                let settings = RenderSettings { strategy: Strategy::Mis, mis, ..Default::default() };
+                check_with(settings, 50_000, 50_000);
+            }
+        }
+    }
+    let mis = MisSettings { light: LightTechnique::SolidAngle, ..Default::default() };
+    check_with(
+        RenderSettings {
+            strategy: Strategy::Mis,
+            light_selection: LightSelection::Contribution,
+            mis,
+            ..Default::default()
+        },
+        50_000,
+        50_000,
+    );
+}
+
+/// Under one unoccluded triangle on a diffuse surface, projected-solid-angle sampling estimates the constant
+/// (k_d/π) L Ω⊥: every sample equals the closed form, up to float error.
+#[test]
+fn projected_solid_angle_has_zero_variance_under_one_triangle() {
+    let l = Vec3::new(3.0, 2.0, 1.0);
+    let tri = [Vec3::new(-0.5, 1.0, -0.4), Vec3::new(0.6, 1.2, -0.3), Vec3::new(0.1, 0.9, 0.7)];
+    let f = 50.0;
+    let positions = vec![
+        [Vec3::new(-f, 0.0, -f), Vec3::new(-f, 0.0, f), Vec3::new(f, 0.0, f)],
+        [Vec3::new(-f, 0.0, -f), Vec3::new(f, 0.0, f), Vec3::new(f, 0.0, -f)],
+        tri, // (b − a) × (c − a) points down, towards the floor
+    ];
+    let floor = Material { kd: Vec3::splat(0.5), ks: Vec3::ZERO, alpha: 1.0, emission: Vec3::ZERO };
+    let light = Material { kd: Vec3::ZERO, ks: Vec3::ZERO, alpha: 1.0, emission: l };
+    let scene =
+        Scene::new("one", any_camera(), &positions, &[0, 0, 1], vec![floor, light], vec!["f".into(), "l".into()])
+            .expect("valid scene");
+    let poly: Vec<DVec3> = tri.iter().map(|v| v.as_dvec3()).collect();
+    for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.8, 0.0, 0.5), Vec3::new(3.0, 0.0, -2.0)] {
+        let sp = ShadingPoint::new(p, Vec3::Y, Vec3::new(0.1, 1.0, 0.2).normalize(), &scene.materials[0]);
+        let settings = RenderSettings { strategy: Strategy::ProjectedSolidAngle, ..Default::default() };
+        let est = estimate_with(&scene, &sp, &settings, 20_000);
+        let expected = l.as_dvec3() * (0.5 / PI) * lambert_polygon_irradiance(p.as_dvec3(), DVec3::Y, &poly, 1.0);
+        let relative_sd = est.std_error * (20_000f64).sqrt() / expected;
+        eprintln!("p = {p}: mean {:.6?}, expected {:.6?}, relative sd {:.2e}", est.mean, expected, relative_sd.x);
+        assert!(relative_sd.max_element() < 1e-4, "variance is not zero: relative sd {relative_sd:?}");
+        assert!(((est.mean - expected) / expected).abs().max_element() < 1e-4);
+    }
 }

@@ -1,52 +1,93 @@
-//! One sample of the scattering integral: `f_r(ω_k, ω_o) L_i(ω_k) (ω_k·n) / p(ω_k)`.
+//! One sample of the scattering integral: `f_r(ω_k, ω_o) L_i(ω_k) (ω_k·n) / p(ω_k)`, or, for MIS, the weighted
+//! combination of a light and a BRDF technique.
 
-use super::{ShadingPoint, Strategy, Target};
+use super::strategy::{DirectionSample, MisSettings, Target};
+use super::{RenderSettings, ShadingPoint, Strategy};
 use crate::math::{SampleRng, offset_ray_origin};
 use crate::scene::{EmitterSampler, Scene};
 use glam::Vec3;
 
-/// Estimates the reflected radiance at `sp` with one sample of `strategy`. Returns the contribution (possibly
-/// non-finite if the inputs are pathological: callers drop and count such samples) and adds the rays traced to
-/// `rays`.
+/// Estimates the reflected radiance at `sp` with one sample of the settings' strategy. Returns the contribution
+/// (possibly non-finite for pathological input: callers drop and count such samples) and adds the rays traced.
 #[inline]
 pub fn estimate_direct(
     scene: &Scene,
     sp: &ShadingPoint,
-    strategy: Strategy,
+    settings: &RenderSettings,
     emitters: Option<&EmitterSampler>,
     rng: &mut SampleRng,
     rays: &mut u64,
 ) -> Vec3 {
-    let Some(s) = strategy.sample(sp, scene, emitters, rng) else { return Vec3::ZERO };
+    if settings.strategy == Strategy::Mis {
+        return estimate_mis(scene, sp, &settings.mis, emitters, rng, rays);
+    }
+    let Some(s) = settings.strategy.sample(sp, scene, emitters, rng) else { return Vec3::ZERO };
+    match integrand(scene, sp, &s, rays) {
+        Some((value, _)) => value / s.pdf,
+        None => Vec3::ZERO,
+    }
+}
+
+/// `f_r L_i (ω·n)` for a sampled direction (not yet divided by the density), and the emitter triangle and point
+/// it reached. `None` where it is zero.
+#[inline]
+fn integrand(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, rays: &mut u64) -> Option<(Vec3, (u32, Vec3))> {
     let cos = sp.n.dot(s.wi);
     if !(cos > 0.0 && s.pdf > 0.0) {
-        return Vec3::ZERO;
+        return None;
     }
     let f = sp.material.eval_brdf(sp.n, sp.wo, s.wi);
     if f == Vec3::ZERO {
-        return Vec3::ZERO;
+        return None;
     }
-    let li = match s.target {
-        Target::Trace => incident_radiance(scene, sp.p, sp.n, s.wi, rays),
+    let (li, reached) = match s.target {
+        Target::Trace => {
+            *rays += 1;
+            let origin = offset_ray_origin(sp.p, sp.n);
+            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY)?;
+            (scene.emitted(hit.triangle, -s.wi), (hit.triangle, origin + s.wi * hit.t))
+        }
         Target::Emitter { triangle, point } => {
             let le = scene.emitted(triangle, -s.wi);
             if le == Vec3::ZERO || !visible(scene, sp.p, sp.n, point, scene.triangles[triangle as usize].n, rays) {
-                return Vec3::ZERO;
+                return None;
             }
-            le
+            (le, (triangle, point))
         }
     };
-    f * li * (cos / s.pdf)
+    (li != Vec3::ZERO).then_some((f * li * cos, reached))
 }
 
-/// L_i(ω): the radiance emitted towards p by the first surface along ω, or 0.
-#[inline]
-pub fn incident_radiance(scene: &Scene, p: Vec3, n: Vec3, wi: Vec3, rays: &mut u64) -> Vec3 {
-    *rays += 1;
-    match scene.accel().closest_hit(offset_ray_origin(p, n), wi, f32::INFINITY) {
-        Some(hit) => scene.emitted(hit.triangle, -wi),
-        None => Vec3::ZERO,
+/// Veach's multi-sample MIS estimator (see [`super::strategy::mis`]).
+fn estimate_mis(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    mis: &MisSettings,
+    emitters: Option<&EmitterSampler>,
+    rng: &mut SampleRng,
+    rays: &mut u64,
+) -> Vec3 {
+    let (n_l, n_b) = (mis.light_samples, mis.brdf_samples);
+    let mut total = Vec3::ZERO;
+    if let Some(emitters) = emitters {
+        for _ in 0..n_l {
+            let Some(s) = mis.light.sample(sp, scene, emitters, rng) else { continue };
+            if let Some((value, _)) = integrand(scene, sp, &s, rays) {
+                let p_b = sp.material.pdf_brdf(sp.n, sp.wo, s.wi);
+                let w = mis.heuristic.weight(n_l, s.pdf, n_b, p_b);
+                total += value * (w / (n_l as f32 * s.pdf));
+            }
+        }
     }
+    for _ in 0..n_b {
+        let Some(s) = Strategy::Brdf.sample(sp, scene, emitters, rng) else { continue };
+        if let Some((value, (triangle, x))) = integrand(scene, sp, &s, rays) {
+            let p_l = emitters.map_or(0.0, |e| mis.light.pdf(sp, scene, e, triangle, x, s.wi));
+            let w = if n_l == 0 { 1.0 } else { mis.heuristic.weight(n_b, s.pdf, n_l, p_l) };
+            total += value * (w / (n_b as f32 * s.pdf));
+        }
+    }
+    total
 }
 
 /// Shadow ray between p (normal n, on the side of x) and the point x on an emitter (normal n_x, facing p): both

@@ -14,4 +14,4 @@ pub use film::{Film, PixelAccum};
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;
-pub use strategy::{DirectionSample, Strategy, Target};
+pub use strategy::{DirectionSample, Heuristic, LightTechnique, MisSettings, Strategy, Target};

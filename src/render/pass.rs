@@ -2,6 +2,7 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
+use super::strategy::MisSettings;
 use super::{Film, ShadingPoint, Strategy, estimate_direct};
 use crate::math::SampleRng;
 use crate::scene::{Camera, CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
@@ -14,11 +15,18 @@ pub struct RenderSettings {
     pub strategy: Strategy,
     pub light_selection: LightSelection,
     pub seed: u64,
+    /// Used by [`Strategy::Mis`].
+    pub mis: MisSettings,
 }
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { strategy: Strategy::Emitter, light_selection: LightSelection::Power, seed: 0 }
+        Self {
+            strategy: Strategy::Emitter,
+            light_selection: LightSelection::Power,
+            seed: 0,
+            mis: MisSettings::default(),
+        }
     }
 }
 
@@ -125,7 +133,7 @@ impl<'a> Renderer<'a> {
         let material = &self.scene.materials[tri.material as usize];
         let sp = ShadingPoint::new(p, tri.n, wo, material);
         let emitted = self.scene.emitted(hit.triangle, wo);
-        emitted + estimate_direct(self.scene, &sp, self.settings.strategy, self.emitters.as_ref(), rng, rays)
+        emitted + estimate_direct(self.scene, &sp, &self.settings, self.emitters.as_ref(), rng, rays)
     }
 }
 

@@ -4,6 +4,8 @@
 mod discrete;
 mod hemisphere;
 mod phong_lobe;
+mod projected_triangle;
+mod spherical_triangle;
 mod triangle;
 
 pub use discrete::DiscreteDistribution;
@@ -11,4 +13,11 @@ pub use hemisphere::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };
 pub use phong_lobe::{phong_lobe_pdf, phong_lobe_pdf_from_gap, sample_phong_lobe};
+pub use projected_triangle::{
+    MIN_ACCEPTANCE, ProjectedPlan, projected_solid_angle, projected_triangle_pdf, sample_projected_triangle,
+};
+pub use spherical_triangle::{
+    MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA, sample_spherical_triangle, spherical_triangle_area,
+    spherical_triangle_pdf,
+};
 pub use triangle::{sample_uniform_triangle, uniform_triangle_pdf_area};

@@ -1,11 +1,9 @@
-//! Emitter sampling (the lecture's area-light sampling): pick an emissive triangle Δ with probability p_Δ, then
-//! a uniform point x on it. Seen from the shading point p, the direction ω = (x − p)/‖x − p‖ has the solid-angle
-//! density `p(ω) = p_Δ ‖x − p‖² / (A_Δ |n_Δ · ω|)`.
+//! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
 use super::Scene;
 use crate::math::luminance;
-use crate::sampling::{DiscreteDistribution, sample_uniform_triangle};
-use glam::{Vec2, Vec3};
+use crate::sampling::DiscreteDistribution;
+use glam::Vec3;
 
 /// How p_Δ is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -17,16 +15,22 @@ pub enum LightSelection {
     /// p_Δ ∝ A_Δ × luminance(L_e): proportional to emitted power.
     #[default]
     Power,
+    /// p_Δ ∝ luminance(L_e) × min(A_Δ cos θ_Δ / d², 2π) at the shading point: an estimate of each triangle's
+    /// contribution there (solid angle × radiance, in the small-triangle limit); 0 for triangles facing away.
+    /// Costs O(number of emitter triangles) per sample.
+    Contribution,
 }
 
 impl LightSelection {
-    pub const ALL: [LightSelection; 3] = [LightSelection::Uniform, LightSelection::Area, LightSelection::Power];
+    pub const ALL: [LightSelection; 4] =
+        [LightSelection::Uniform, LightSelection::Area, LightSelection::Power, LightSelection::Contribution];
 
     pub fn name(self) -> &'static str {
         match self {
             LightSelection::Uniform => "uniform",
             LightSelection::Area => "area",
             LightSelection::Power => "power",
+            LightSelection::Contribution => "contribution",
         }
     }
 
@@ -35,16 +39,10 @@ impl LightSelection {
     }
 }
 
-/// A point on an emitter with the probability of its triangle.
-#[derive(Clone, Copy, Debug)]
-pub struct EmitterSample {
-    pub triangle: u32,
-    pub point: Vec3,
-    pub p_delta: f32,
-}
-
 /// p_Δ over the scene's emissive triangles, for one [`LightSelection`].
 pub struct EmitterSampler {
+    selection: LightSelection,
+    /// For the selections that do not depend on the shading point.
     distribution: DiscreteDistribution,
     /// Emitter triangle of each distribution slot.
     triangles: Vec<u32>,
@@ -70,7 +68,7 @@ impl EmitterSampler {
                         }
                     }
                     LightSelection::Area => area,
-                    LightSelection::Power => {
+                    LightSelection::Power | LightSelection::Contribution => {
                         area * luminance(scene.materials[tri.material as usize].emission).max(0.0) as f64
                     }
                 }
@@ -81,36 +79,62 @@ impl EmitterSampler {
         for (slot, &t) in scene.emitters.iter().enumerate() {
             slot_of[t as usize] = slot as u32;
         }
-        Some(Self { distribution, triangles: scene.emitters.clone(), slot_of })
+        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of })
     }
 
-    /// Picks Δ with `u_select` and a uniform point on it with `u_point`.
+    /// Picks an emitter triangle Δ for the shading point p with one uniform; returns it and p_Δ. `None` where
+    /// the selection gives every triangle weight 0 at p.
     #[inline]
-    pub fn sample(&self, scene: &Scene, u_select: f32, u_point: Vec2) -> EmitterSample {
-        let (slot, p_delta) = self.distribution.sample(u_select);
-        let triangle = self.triangles[slot];
-        let [a, b, c] = scene.triangles[triangle as usize].v;
-        EmitterSample { triangle, point: sample_uniform_triangle(u_point, a, b, c), p_delta }
-    }
-
-    /// p_Δ of a scene triangle (0 for one that does not emit).
-    #[inline]
-    pub fn p_delta(&self, triangle: u32) -> f32 {
-        match self.slot_of.get(triangle as usize) {
-            Some(&slot) if slot != u32::MAX => self.distribution.pmf(slot as usize),
-            _ => 0.0,
+    pub fn pick(&self, scene: &Scene, p: Vec3, u: f32) -> Option<(u32, f32)> {
+        if self.selection != LightSelection::Contribution {
+            let (slot, p_delta) = self.distribution.sample(u);
+            return Some((self.triangles[slot], p_delta));
         }
+        let total: f64 = self.triangles.iter().map(|&t| contribution(scene, t, p)).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let target = u as f64 * total;
+        let mut acc = 0.0;
+        let mut last = None;
+        for &t in &self.triangles {
+            let w = contribution(scene, t, p);
+            if w > 0.0 {
+                acc += w;
+                last = Some((t, w));
+                if target < acc {
+                    break;
+                }
+            }
+        }
+        last.map(|(t, w)| (t, (w / total) as f32))
     }
 
-    /// Solid-angle density at p of the direction towards x on triangle Δ:
-    /// `p_Δ ‖x − p‖² / (A_Δ |n_Δ · ω|)`; 0 when ω grazes the triangle's plane.
+    /// p_Δ of a scene triangle at the shading point p (0 for one that does not emit).
     #[inline]
-    pub fn pdf_solid_angle(&self, scene: &Scene, triangle: u32, p: Vec3, x: Vec3) -> f32 {
-        let tri = &scene.triangles[triangle as usize];
-        let d = x - p;
-        let dist2 = d.length_squared();
-        let cos = tri.n.dot(d).abs() / dist2.sqrt();
-        let denom = tri.area * cos;
-        if denom > 0.0 && dist2 > 0.0 { self.p_delta(triangle) * dist2 / denom } else { 0.0 }
+    pub fn p_delta(&self, scene: &Scene, triangle: u32, p: Vec3) -> f32 {
+        let Some(&slot) = self.slot_of.get(triangle as usize).filter(|&&s| s != u32::MAX) else { return 0.0 };
+        if self.selection != LightSelection::Contribution {
+            return self.distribution.pmf(slot as usize);
+        }
+        let total: f64 = self.triangles.iter().map(|&t| contribution(scene, t, p)).sum();
+        let w = contribution(scene, triangle, p);
+        if total > 0.0 { (w / total) as f32 } else { 0.0 }
     }
+}
+
+/// luminance(L_e) × min(A cos θ_Δ / d², 2π) from p to the triangle's centroid; 0 when p is behind it.
+#[inline]
+fn contribution(scene: &Scene, t: u32, p: Vec3) -> f64 {
+    let tri = &scene.triangles[t as usize];
+    let centroid = (tri.v[0] + tri.v[1] + tri.v[2]) / 3.0;
+    let d = (p - centroid).as_dvec3();
+    let d2 = d.length_squared();
+    let cos = tri.n.as_dvec3().dot(d);
+    if !(cos > 0.0) || tri.n.dot(p - tri.v[0]) <= 0.0 {
+        return 0.0;
+    }
+    let solid_angle = (tri.area as f64 * cos / (d2 * d2.sqrt())).min(std::f64::consts::TAU);
+    let l = luminance(scene.materials[tri.material as usize].emission).max(0.0) as f64;
+    if solid_angle.is_finite() { solid_angle * l } else { std::f64::consts::TAU * l }
 }

@@ -13,7 +13,7 @@ mod material;
 pub use accel::{Accel, Hit};
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
-pub use emitters::{EmitterSample, EmitterSampler, LightSelection};
+pub use emitters::{EmitterSampler, LightSelection};
 pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
 pub use load::{load_scene, load_scene_file};

@@ -6,7 +6,7 @@ pub mod chi2;
 
 use glam::{DVec3, Vec3};
 use illumlab::math::SampleRng;
-use illumlab::render::{ShadingPoint, Strategy, estimate_direct};
+use illumlab::render::{RenderSettings, ShadingPoint, Strategy, estimate_direct};
 use illumlab::scene::{Camera, EmitterSampler, LightSelection, Material, Scene};
 
 /// A camera that is never used to render: the estimators are evaluated at chosen shading points.
@@ -70,11 +70,17 @@ pub fn estimate_at(
     n: u64,
     seed: u64,
 ) -> Estimate {
+    estimate_with(scene, sp, &RenderSettings { strategy, light_selection: selection, seed, ..Default::default() }, n)
+}
+
+/// As [`estimate_at`], with every setting given (MIS among them).
+pub fn estimate_with(scene: &Scene, sp: &ShadingPoint, settings: &RenderSettings, n: u64) -> Estimate {
+    let (seed, selection) = (settings.seed, settings.light_selection);
     let emitters = EmitterSampler::new(scene, selection);
     let (mut sum, mut sum_sq, mut non_finite, mut rays) = (DVec3::ZERO, DVec3::ZERO, 0, 0);
     for i in 0..n {
         let mut rng = SampleRng::new(seed, 0, i);
-        let v = estimate_direct(scene, sp, strategy, emitters.as_ref(), &mut rng, &mut rays);
+        let v = estimate_direct(scene, sp, settings, emitters.as_ref(), &mut rng, &mut rays);
         if v.is_finite() {
             let v = v.as_dvec3();
             sum += v;

@@ -4,7 +4,14 @@
 mod brdf;
 mod cosine;
 mod emitter;
+pub mod light;
+pub mod mis;
+mod projected_solid_angle;
+mod solid_angle;
 mod uniform;
+
+pub use light::LightTechnique;
+pub use mis::{Heuristic, MisSettings};
 
 use super::ShadingPoint;
 use crate::math::SampleRng;
@@ -38,10 +45,21 @@ pub enum Strategy {
     Cosine,
     Brdf,
     Emitter,
+    SolidAngle,
+    ProjectedSolidAngle,
+    Mis,
 }
 
 impl Strategy {
-    pub const ALL: [Strategy; 4] = [Strategy::Uniform, Strategy::Cosine, Strategy::Brdf, Strategy::Emitter];
+    pub const ALL: [Strategy; 7] = [
+        Strategy::Uniform,
+        Strategy::Cosine,
+        Strategy::Brdf,
+        Strategy::Emitter,
+        Strategy::SolidAngle,
+        Strategy::ProjectedSolidAngle,
+        Strategy::Mis,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -49,6 +67,9 @@ impl Strategy {
             Strategy::Cosine => "cosine",
             Strategy::Brdf => "brdf",
             Strategy::Emitter => "emitter",
+            Strategy::SolidAngle => "solid-angle",
+            Strategy::ProjectedSolidAngle => "projected-solid-angle",
+            Strategy::Mis => "mis",
         }
     }
 
@@ -63,6 +84,9 @@ impl Strategy {
             Strategy::Cosine => cosine::DESCRIPTION,
             Strategy::Brdf => brdf::DESCRIPTION,
             Strategy::Emitter => emitter::DESCRIPTION,
+            Strategy::SolidAngle => solid_angle::DESCRIPTION,
+            Strategy::ProjectedSolidAngle => projected_solid_angle::DESCRIPTION,
+            Strategy::Mis => mis::DESCRIPTION,
         }
     }
 
@@ -73,10 +97,24 @@ impl Strategy {
             Strategy::Cosine => cosine::PDF,
             Strategy::Brdf => brdf::PDF,
             Strategy::Emitter => emitter::PDF,
+            Strategy::SolidAngle => solid_angle::PDF,
+            Strategy::ProjectedSolidAngle => projected_solid_angle::PDF,
+            Strategy::Mis => mis::PDF,
         }
     }
 
-    /// Draws ω_k. `None`: no sample could be taken (it counts as zero).
+    /// The light technique of a light strategy.
+    pub fn light_technique(self) -> Option<LightTechnique> {
+        match self {
+            Strategy::Emitter => Some(LightTechnique::Area),
+            Strategy::SolidAngle => Some(LightTechnique::SolidAngle),
+            Strategy::ProjectedSolidAngle => Some(LightTechnique::ProjectedSolidAngle),
+            _ => None,
+        }
+    }
+
+    /// Draws ω_k. `None`: no sample could be taken (it counts as zero). MIS draws several directions and is
+    /// evaluated by the estimator instead.
     #[inline]
     pub fn sample(
         self,
@@ -89,7 +127,10 @@ impl Strategy {
             Strategy::Uniform => uniform::sample(sp, rng),
             Strategy::Cosine => cosine::sample(sp, rng),
             Strategy::Brdf => brdf::sample(sp, rng),
-            Strategy::Emitter => emitter::sample(sp, scene, emitters?, rng),
+            Strategy::Emitter | Strategy::SolidAngle | Strategy::ProjectedSolidAngle => {
+                self.light_technique()?.sample(sp, scene, emitters?, rng)
+            }
+            Strategy::Mis => None,
         }
     }
 }

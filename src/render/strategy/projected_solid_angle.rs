@@ -1,0 +1,41 @@
+//! Projected-solid-angle light sampling: pick a triangle with p_Δ, then a direction with density ∝ (ω·n) over
+//! it: `p(ω) = p_Δ (ω·n)⁺ / Ω⊥_Δ`. On a diffuse surface under one unoccluded triangle the estimate is the
+//! constant `(k_d/π) L Ω⊥`: its only variance is visibility and the choice of triangle. Exact by rejection from
+//! spherical-triangle samples; area sampling where that would be inefficient (see [`ProjectedPlan`]).
+
+use super::light::{area_pdf_solid_angle, hit_plane};
+use crate::math::SampleRng;
+use crate::render::ShadingPoint;
+use crate::sampling::{ProjectedPlan, projected_triangle_pdf, sample_projected_triangle};
+use crate::scene::Triangle;
+use glam::Vec3;
+
+pub const DESCRIPTION: &str = "directions ∝ cos θ over a light triangle (exact, by rejection): ideal for diffuse";
+pub const PDF: &str = "p(ω) = p_Δ (ω·n) / Ω⊥_Δ,  Ω⊥_Δ = ½ Σ Θ_i (n·γ_i)";
+
+fn plan(sp: &ShadingPoint, tri: &Triangle) -> ProjectedPlan {
+    let [a, b, c] = tri.v;
+    ProjectedPlan::new(sp.p, sp.n, a, b, c)
+}
+
+#[inline]
+pub fn sample(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
+    match plan(sp, tri) {
+        ProjectedPlan::Invisible => None,
+        ProjectedPlan::Area => super::emitter::sample(sp, tri, rng),
+        ProjectedPlan::Rejection { projected, cos_max, .. } => {
+            let wi = sample_projected_triangle(rng, sp.p, sp.n, tri.v, cos_max)?;
+            let x = hit_plane(sp.p, wi, tri)?;
+            Some((wi, projected_triangle_pdf(wi.dot(sp.n), projected), x))
+        }
+    }
+}
+
+#[inline]
+pub fn pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
+    match plan(sp, tri) {
+        ProjectedPlan::Invisible => 0.0,
+        ProjectedPlan::Area => area_pdf_solid_angle(sp.p, tri, x, wi),
+        ProjectedPlan::Rejection { projected, .. } => projected_triangle_pdf(wi.dot(sp.n), projected),
+    }
+}

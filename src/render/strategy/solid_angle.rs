@@ -1,0 +1,40 @@
+//! Solid-angle light sampling: pick a triangle with p_Δ, then a direction uniformly in the spherical triangle it
+//! subtends (Arvo 1995): `p(ω) = p_Δ / Ω_Δ`. No 1/r² in the estimator, so a light touching the surface is no
+//! harder than a far one. Where Ω_Δ < 3·10⁻⁴ sr or > 6.22 sr (float precision; pbrt-v4's limits) it samples the
+//! area instead, with that density.
+
+use super::light::{area_pdf_solid_angle, hit_plane};
+use crate::math::SampleRng;
+use crate::render::ShadingPoint;
+use crate::sampling::{
+    MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA, sample_spherical_triangle, spherical_triangle_area,
+    spherical_triangle_pdf,
+};
+use crate::scene::Triangle;
+use glam::Vec3;
+
+pub const DESCRIPTION: &str = "uniform directions in the spherical triangle of a light triangle (Arvo 1995)";
+pub const PDF: &str = "p(ω) = p_Δ / Ω_Δ   (area sampling where Ω_Δ < 3e-4 or > 6.22 sr)";
+
+fn spherical(solid_angle: f32) -> bool {
+    (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&solid_angle)
+}
+
+#[inline]
+pub fn sample(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
+    let [a, b, c] = tri.v;
+    let omega = spherical_triangle_area(sp.p, a, b, c);
+    if !spherical(omega) {
+        return super::emitter::sample(sp, tri, rng);
+    }
+    let wi = sample_spherical_triangle(rng.uniform_2d(), sp.p, a, b, c)?;
+    let x = hit_plane(sp.p, wi, tri)?;
+    Some((wi, spherical_triangle_pdf(omega), x))
+}
+
+#[inline]
+pub fn pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
+    let [a, b, c] = tri.v;
+    let omega = spherical_triangle_area(sp.p, a, b, c);
+    if spherical(omega) { spherical_triangle_pdf(omega) } else { area_pdf_solid_angle(sp.p, tri, x, wi) }
+}
