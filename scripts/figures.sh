@@ -10,6 +10,7 @@ for scene in cornell-box veach-mis near-light default; do
   for strategy in $($bin strategies | awk '{print $1}'); do
     exposure=0
     [ "$scene" = cornell-box ] && exposure=1
+    [ "$scene" = near-light ] && exposure=-3
     $bin render "$scene" --strategy "$strategy" --spp "$spp" --seed 1 --exposure "$exposure" \
       -o "screenshots/$scene-$strategy.png"
   done

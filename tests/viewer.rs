@@ -5,7 +5,7 @@ use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illumlab::app::Viewer;
-use illumlab::render::Strategy;
+use illumlab::render::{Heuristic, Strategy};
 use illumlab::scene::load_scene;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -151,4 +151,23 @@ fn choosing_a_bundled_scene_loads_it_in_the_background() {
     h.step();
     step_until(&mut h, "the near-light frame", |v| v.frame().is_some_and(|f| f.scene_name == "near-light"));
     assert_eq!(h.state().scene().name, "near-light");
+}
+
+#[test]
+fn mis_controls_reach_the_integrator() {
+    let mut h = harness(viewer());
+    h.get_by_label("7 mis").click();
+    h.step();
+    h.step();
+    h.get_by_role_and_label(Role::RadioButton, "balance").click();
+    h.step();
+    step_until(&mut h, "a balance-heuristic MIS frame", |v| {
+        v.frame()
+            .is_some_and(|f| f.settings.strategy == Strategy::Mis && f.settings.mis.heuristic == Heuristic::Balance)
+    });
+    h.get_by_role_and_label(Role::Slider, "light / BRDF split").set_value_accesskit(3.0);
+    h.step();
+    step_until(&mut h, "a 3 + 1 split", |v| {
+        v.frame().is_some_and(|f| f.settings.mis.light_samples == 3 && f.settings.mis.brdf_samples == 1)
+    });
 }

@@ -1,7 +1,7 @@
 //! The side panel: scene, strategy, light selection, sampling budget, seed, exposure, Phong material, export.
 
 use super::viewer::Viewer;
-use crate::render::Strategy;
+use crate::render::{Heuristic, LightTechnique, Strategy};
 use crate::scene::{BUNDLED_SCENES, LightSelection};
 use glam::Vec3;
 
@@ -61,6 +61,9 @@ fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     let s = v.settings.strategy;
     ui.label(s.description());
     ui.label(egui::RichText::new(s.pdf_formula()).monospace());
+    if s == Strategy::Mis {
+        mis_ui(v, ui);
+    }
     let mut selection = v.settings.light_selection;
     egui::ComboBox::from_label("light selection p_Δ").selected_text(selection.name()).show_ui(ui, |ui| {
         for l in LightSelection::ALL {
@@ -72,6 +75,35 @@ fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         v.apply_settings();
     }
 }
+
+/// MIS: which light strategy, which heuristic, and how a pixel sample's 4 directions split between the two.
+fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+    let mut mis = v.settings.mis;
+    egui::ComboBox::from_label("MIS light strategy").selected_text(mis.light.name()).show_ui(ui, |ui| {
+        for t in LightTechnique::ALL {
+            ui.selectable_value(&mut mis.light, t, t.name());
+        }
+    });
+    ui.horizontal(|ui| {
+        for h in Heuristic::ALL {
+            ui.radio_value(&mut mis.heuristic, h, h.name());
+        }
+        ui.label("heuristic");
+    });
+    let total = MIS_DIRECTIONS;
+    let mut light = mis.light_samples.min(total);
+    ui.add(egui::Slider::new(&mut light, 0..=total).text("light / BRDF split"));
+    mis.light_samples = light;
+    mis.brdf_samples = total - light;
+    ui.small(format!("{} light + {} BRDF directions per pixel sample", mis.light_samples, mis.brdf_samples));
+    if mis != v.settings.mis {
+        v.settings.mis = mis;
+        v.apply_settings();
+    }
+}
+
+/// Directions per pixel sample that the MIS split slider shares out.
+const MIS_DIRECTIONS: u32 = 4;
 
 fn sampling_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     ui.heading("Sampling");

@@ -10,8 +10,8 @@ use crate::sampling::{ProjectedPlan, projected_triangle_pdf, sample_projected_tr
 use crate::scene::Triangle;
 use glam::Vec3;
 
-pub const DESCRIPTION: &str = "directions ∝ cos θ over a light triangle (exact, by rejection): ideal for diffuse";
-pub const PDF: &str = "p(ω) = p_Δ (ω·n) / Ω⊥_Δ,  Ω⊥_Δ = ½ Σ Θ_i (n·γ_i)";
+pub const DESCRIPTION: &str = "directions proportional to cos θ over a light triangle (exact): ideal for diffuse";
+pub const PDF: &str = "p(ω) = p_Δ (ω·n) / Ω_proj,  Ω_proj = ½ Σ Θ_i (n·γ_i)";
 
 fn plan(sp: &ShadingPoint, tri: &Triangle) -> ProjectedPlan {
     let [a, b, c] = tri.v;
