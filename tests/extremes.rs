@@ -42,6 +42,9 @@ fn scene(camera: Camera) -> Scene {
     let s = 2.0f32.sqrt() * 1e-5;
     positions.push([Vec3::new(2.0, 0.5, 0.0), Vec3::new(2.0 + s, 0.5, 0.0), Vec3::new(2.0, 0.5, s)]);
     ids.push(2);
+X
+    positions.push([Vec3::new(-3.0, 0.0, -0.5), Vec3::new(-3.0, 0.6, 0.0), Vec3::new(-3.0, 0.0, 0.5)]);
+    ids.push(1);
     positions.push([Vec3::new(1.0, 0.2, 1.0); 3]);
     positions.push([Vec3::new(0.0, 0.3, 0.0), Vec3::new(1.0, 0.3, 0.0), Vec3::new(2.0, 0.3, 0.0)]);
     ids.extend([1, 2]);
@@ -87,6 +90,7 @@ fn every_strategy_is_finite_at_the_extremes() {
         ("10⁴ away", Vec3::new(1e4, 0.0, 0.0), normal_view),
         ("10⁴ away, grazing", Vec3::new(1e4, 0.0, 0.0), Vec3::new(-1.0, 1e-5, 0.0).normalize()),
         ("under the tiny light", Vec3::new(2.0, 0.0, 0.0), normal_view),
+        ("at the foot of the standing light", Vec3::new(-3.0 + 1e-4, 0.0, 0.0), normal_view),
     ];
     let materials = materials();
     let mut checked = 0;
@@ -103,7 +107,7 @@ fn every_strategy_is_finite_at_the_extremes() {
             }
         }
     }
-    assert_eq!(checked, 8 * 25 * all_settings().len());
+    assert_eq!(checked, 9 * 25 * all_settings().len());
 }
 
 #[test]
