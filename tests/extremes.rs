@@ -42,7 +42,7 @@ fn scene(camera: Camera) -> Scene {
     let s = 2.0f32.sqrt() * 1e-5;
     positions.push([Vec3::new(2.0, 0.5, 0.0), Vec3::new(2.0 + s, 0.5, 0.0), Vec3::new(2.0, 0.5, s)]);
     ids.push(2);
-X
+    // A light standing on the floor: its lower edge touches the shading points' plane (it faces +x).
     positions.push([Vec3::new(-3.0, 0.0, -0.5), Vec3::new(-3.0, 0.6, 0.0), Vec3::new(-3.0, 0.0, 0.5)]);
     ids.push(1);
     positions.push([Vec3::new(1.0, 0.2, 1.0); 3]);
