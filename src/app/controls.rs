@@ -76,7 +76,7 @@ fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     }
 }
 
-/// MIS: which light strategy, which heuristic, and how a pixel sample's 4 directions split between the two.
+/// MIS: which light strategy, which heuristic, and how a pixel sample's directions split between the two.
 fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     let mut mis = v.settings.mis;
     egui::ComboBox::from_label("MIS light strategy").selected_text(mis.light.name()).show_ui(ui, |ui| {
@@ -90,11 +90,12 @@ fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         }
         ui.label("heuristic");
     });
-    let total = MIS_DIRECTIONS;
-    let mut light = mis.light_samples.min(total);
-    ui.add(egui::Slider::new(&mut light, 0..=total).text("light / BRDF split"));
-    mis.light_samples = light;
-    mis.brdf_samples = total - light;
+    // Only a move of the slider re-splits: a split set elsewhere (the command line's 1,1) stays as it is.
+    let mut light = mis.light_samples.min(MIS_DIRECTIONS);
+    if ui.add(egui::Slider::new(&mut light, 0..=MIS_DIRECTIONS).text("light / BRDF split")).changed() {
+        mis.light_samples = light;
+        mis.brdf_samples = MIS_DIRECTIONS - light;
+    }
     ui.small(format!("{} light + {} BRDF directions per pixel sample", mis.light_samples, mis.brdf_samples));
     if mis != v.settings.mis {
         v.settings.mis = mis;

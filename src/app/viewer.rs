@@ -64,9 +64,7 @@ impl Viewer {
         };
         // Leave the UI thread a core: on two cores the passes run on one.
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1));
-        let mut settings = RenderSettings::default();
-        settings.mis.light_samples = 2;
-        settings.mis.brdf_samples = 2;
+        let settings = RenderSettings::default();
         let worker = Worker::spawn(scene.clone(), settings, threads, notify);
         let camera = scene.camera;
         let mut viewer = Self {

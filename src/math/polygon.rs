@@ -1,5 +1,4 @@
-//! Closed forms over spherical polygons: solid angle and Lambert's irradiance from a uniformly emitting polygon.
-//! They are the ground truth the estimators are tested against.
+//! Lambert's irradiance from a uniformly emitting polygon: the ground truth the estimators are tested against.
 
 use glam::DVec3;
 
@@ -23,20 +22,6 @@ pub fn lambert_polygon_irradiance(p: DVec3, n: DVec3, vertices: &[DVec3], radian
     }
     // The winding of the polygon as seen from p decides the sign; irradiance is its magnitude.
     0.5 * radiance * sum.abs()
-}
-
-/// Solid angle that a planar polygon subtends at `p` (Van Oosterom & Strackee 1983, summed over a fan of
-/// triangles). Not clipped.
-pub fn polygon_solid_angle(p: DVec3, vertices: &[DVec3]) -> f64 {
-    let mut total = 0.0;
-    for i in 1..vertices.len().saturating_sub(1) {
-        let (a, b, c) = (vertices[0] - p, vertices[i] - p, vertices[i + 1] - p);
-        let (la, lb, lc) = (a.length(), b.length(), c.length());
-        let num = a.dot(b.cross(c));
-        let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
-        total += 2.0 * num.atan2(den);
-    }
-    total.abs()
 }
 
 /// Sutherland–Hodgman clip of the polygon (relative to p) against the plane n·x ≥ 0.
@@ -85,8 +70,6 @@ mod tests {
         let e = lambert_polygon_irradiance(DVec3::ZERO, DVec3::Y, &square(half, h), 1.0);
         let approx = (2.0 * half) * (2.0 * half) / (h * h);
         assert!((e / approx - 1.0).abs() < 1e-5);
-        let omega = polygon_solid_angle(DVec3::ZERO, &square(half, h));
-        assert!((omega / approx - 1.0).abs() < 1e-5);
     }
 
     #[test]

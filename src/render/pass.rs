@@ -74,10 +74,6 @@ impl<'a> Renderer<'a> {
         }
     }
 
-    pub fn settings(&self) -> &RenderSettings {
-        &self.settings
-    }
-
     /// Adds samples `first..first + count` to every pixel of `film` (which must match the camera's size).
     /// `cancelled` is polled once per row; when it returns true the pass stops early and leaves the film
     /// partially updated (the caller discards it).

@@ -112,11 +112,6 @@ impl Worker {
     pub fn generation(&self) -> u64 {
         self.generation.load(Ordering::SeqCst)
     }
-
-    /// True while the thread is alive.
-    pub fn is_running(&self) -> bool {
-        self.thread.as_ref().is_some_and(|t| !t.is_finished())
-    }
 }
 
 impl Drop for Worker {

@@ -27,14 +27,6 @@ impl DiscreteDistribution {
         Some(Self { cdf, pmf })
     }
 
-    pub fn len(&self) -> usize {
-        self.pmf.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.pmf.is_empty()
-    }
-
     /// Picks index i with probability `pmf(i)`; returns it and its probability.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {

@@ -1,7 +1,7 @@
 //! The lecture's Phong material: `f_r(ω, ω_o) = k_d/π + k_s (α+1)/(2π) max(0, ω·ω_r)^α`, ω_r the mirror of ω_o
 //! about n, plus an emitted radiance for area lights.
 
-use crate::math::{Frame, ONE_MINUS_EPSILON, luminance, reflect};
+use crate::math::{Frame, ONE_MINUS_EPSILON, reflect};
 use crate::sampling::{cosine_hemisphere_pdf, phong_lobe_pdf_from_gap, sample_cosine_hemisphere, sample_phong_lobe};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -81,11 +81,6 @@ impl Material {
             p += (1.0 - p_d) * phong_lobe_pdf_from_gap(mirror_gap(n, wo, wi), self.alpha);
         }
         p
-    }
-
-    /// Luminance of the emitted radiance.
-    pub fn emitted_luminance(&self) -> f32 {
-        luminance(self.emission)
     }
 }
 
