@@ -104,12 +104,19 @@ fn strategies_agree_on_veach_mis_where_both_are_well_sampled() {
     scene.camera.height = 24;
     let spp = 1024;
     let emitter = regions(&scene, Strategy::Emitter, spp, 3);
-    for (strategy, seed) in [(Strategy::Brdf, 4), (Strategy::Cosine, 5), (Strategy::Uniform, 6)] {
+    let others = Strategy::ALL.into_iter().filter(|s| *s != Strategy::Emitter);
+    for (strategy, seed) in others.zip(4..) {
         let r = regions(&scene, strategy, spp, seed);
         let compared = assert_agree(&scene, &r, &emitter, &format!("{} vs emitter", strategy.name()), 30.0);
         // At 1 024 spp only a few regions (the big light's surroundings) are well sampled by both: the rest of
         // the image is the rare-event regime the scene was built to show.
-        assert!(compared >= 3, "{}: the gate leaves something to compare", strategy.name());
+        // Light strategies and MIS sample the diffuse backdrop well, so a good part of the image is compared. The
+        // hemisphere strategies and BRDF sampling are rare-event estimators almost everywhere at this budget
+        // (they are checked against the closed form in `unbiased.rs`): no floor for them.
+        if strategy.light_technique().is_some() || strategy == Strategy::Mis {
+            let channels = 3 * r.len();
+            assert!(3 * compared >= channels, "{}: only {compared} of {channels} compared", strategy.name());
+        }
     }
 }
 
