@@ -97,13 +97,6 @@ pub struct MisArgs {
     pub mis_samples: (u32, u32),
 }
 
-impl Default for MisArgs {
-    fn default() -> Self {
-        let m = MisSettings::default();
-        Self { mis_light: m.light, mis_heuristic: m.heuristic, mis_samples: (m.light_samples, m.brdf_samples) }
-    }
-}
-
 impl MisArgs {
     fn settings(&self) -> MisSettings {
         MisSettings {
@@ -150,6 +143,14 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     match (parse(w), parse(h)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err("width and height must be whole numbers from 1 to 16384".into()),
+    }
+}
+
+/// `illumlab view` with clap's defaults: what runs without a subcommand.
+pub fn default_command() -> Command {
+    match Cli::try_parse_from(["illumlab", "view"]).map(|c| c.command) {
+        Ok(Some(command)) => command,
+        _ => unreachable!("`illumlab view` parses"),
     }
 }
 
@@ -247,17 +248,16 @@ fn pass_size(spp: u32, pixels: usize) -> u32 {
     ((2_000_000 / pixels.max(1)) as u32).clamp(1, spp)
 }
 
-impl Default for ViewArgs {
-    fn default() -> Self {
-        Self {
-            scene: None,
-            strategy: Strategy::Emitter,
-            seed: 0,
-            light_selection: LightSelection::Power,
-            target_spp: None,
-            exposure: 0.0,
-            size: None,
-            mis: MisArgs::default(),
-        }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_subcommand_means_view_with_the_documented_defaults() {
+        let Command::View(args) = default_command() else { panic!("not `view`") };
+        assert_eq!(args.scene, None);
+        assert_eq!(args.strategy, Strategy::Emitter);
+        assert_eq!(args.light_selection, LightSelection::Power);
+        assert_eq!(args.mis.settings(), MisSettings::default());
     }
 }

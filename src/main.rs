@@ -20,7 +20,7 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    match cli::run(cli.command.unwrap_or(cli::Command::View(cli::ViewArgs::default()))) {
+    match cli::run(cli.command.unwrap_or_else(cli::default_command)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");

@@ -16,24 +16,47 @@ use illumlab::sampling::{
 
 const TESTS_IN_FILE: usize = 9;
 
-fn check(name: &str, p: Vec3, tri: [Vec3; 3], seed: u64) {
+/// Tests a direction sampler against its solid-angle density on triangle `tri` seen from p: each direction is
+/// mapped to the point it hits on the triangle's plane, where the density is `pdf(ω) cos θ_Δ / d²`.
+fn check_directions(
+    name: &str,
+    p: Vec3,
+    tri: [Vec3; 3],
+    seed: u64,
+    sample: &dyn Fn(Vec2) -> Vec3,
+    pdf: &dyn Fn(Vec3) -> f64,
+) {
     let [a, b, c] = tri;
-    let n = (b - a).cross(c - a).normalize();
-    let omega = spherical_triangle_area(p, a, b, c);
-    let hit = |w: Vec3| p + w * (n.dot(a - p) / n.dot(w));
+    let plane = (b - a).cross(c - a).normalize();
     let o = triangle_test(
         tri,
         12,
         400_000,
         seed,
-        &|u: Vec2| hit(sample_spherical_triangle(u, p, a, b, c).expect("a sample")),
+        &|u: Vec2| {
+            let w = sample(u);
+            p + w * (plane.dot(a - p) / plane.dot(w))
+        },
         &|x: Vec3| {
             let d = x - p;
-            let cos = n.dot(d).abs() / d.length();
-            spherical_triangle_pdf(omega) as f64 * cos as f64 / d.length_squared() as f64
+            let w = d / d.length();
+            pdf(w) * plane.dot(w).abs() as f64 / d.length_squared() as f64
         },
     );
-    assert_fits(&format!("{name} (Ω = {omega:.3e} sr)"), &o);
+    assert_fits(name, &o);
+}
+
+fn check(name: &str, p: Vec3, tri: [Vec3; 3], seed: u64) {
+    let [a, b, c] = tri;
+    let omega = spherical_triangle_area(p, a, b, c);
+    check_directions(
+        &format!("{name} (Ω = {omega:.3e} sr)"),
+        p,
+        tri,
+        seed,
+        &|u| sample_spherical_triangle(u, p, a, b, c).expect("a sample"),
+        &|_| spherical_triangle_pdf(omega) as f64,
+    );
 }
 
 /// The density integrates to one and the histogram fits it.
@@ -76,28 +99,20 @@ fn triangle_at_grazing_elevation() {
 /// stream from the tester's two uniforms.
 fn check_projected(name: &str, p: Vec3, n: Vec3, tri: [Vec3; 3], seed: u64) {
     let [a, b, c] = tri;
-    let plane = (b - a).cross(c - a).normalize();
     let ProjectedPlan::Rejection { projected, cos_max, .. } = ProjectedPlan::new(p, n, a, b, c) else {
         panic!("{name}: expected the rejection plan");
     };
-    let hit = |w: Vec3| p + w * (plane.dot(a - p) / plane.dot(w));
-    let o = triangle_test(
+    check_directions(
+        &format!("projected, {name}"),
+        p,
         tri,
-        12,
-        400_000,
         seed,
-        &|u: Vec2| {
+        &|u| {
             let mut rng = SampleRng::new(u.x.to_bits() as u64, u.y.to_bits() as u64, seed);
-            hit(sample_projected_triangle(&mut rng, p, n, tri, cos_max).expect("a sample"))
+            sample_projected_triangle(&mut rng, p, n, tri, cos_max).expect("a sample")
         },
-        &|x: Vec3| {
-            let d = x - p;
-            let w = d / d.length();
-            let cos_light = plane.dot(w).abs();
-            projected_triangle_pdf(w.dot(n), projected) as f64 * cos_light as f64 / d.length_squared() as f64
-        },
+        &|w| projected_triangle_pdf(w.dot(n), projected) as f64,
     );
-    assert_fits(&format!("projected, {name}"), &o);
 }
 
 #[test]

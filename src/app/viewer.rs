@@ -54,14 +54,7 @@ pub struct Viewer {
 impl Viewer {
     pub fn with_scene(scene: Arc<Scene>) -> Self {
         let repaint: Arc<Mutex<Option<egui::Context>>> = Arc::new(Mutex::new(None));
-        let target = repaint.clone();
-        let notify = move || {
-            if let Ok(ctx) = target.lock()
-                && let Some(ctx) = ctx.as_ref()
-            {
-                ctx.request_repaint();
-            }
-        };
+        let notify = notifier(&repaint);
         // Leave the UI thread a core: on two cores the passes run on one.
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1));
         let settings = RenderSettings::default();
@@ -279,14 +272,7 @@ impl Viewer {
 
     /// Starts loading a bundled scene or a file in the background; the current scene stays until it succeeds.
     pub(super) fn open(&mut self, what: String) {
-        let repaint = self.repaint.clone();
-        self.loading = Some(Loading::start(what, move || {
-            if let Ok(ctx) = repaint.lock()
-                && let Some(ctx) = ctx.as_ref()
-            {
-                ctx.request_repaint();
-            }
-        }));
+        self.loading = Some(Loading::start(what, notifier(&self.repaint)));
         self.error = None;
     }
 
@@ -324,5 +310,17 @@ impl Viewer {
     pub(super) fn send_spp(&mut self) {
         self.worker.send(Command::SetSppPerPass(self.spp_per_pass));
         self.worker.send(Command::SetTargetSpp(self.target_spp));
+    }
+}
+
+/// A callback for other threads that asks the bound context, if any, to repaint.
+fn notifier(repaint: &Arc<Mutex<Option<egui::Context>>>) -> impl Fn() + Send + 'static {
+    let target = repaint.clone();
+    move || {
+        if let Ok(ctx) = target.lock()
+            && let Some(ctx) = ctx.as_ref()
+        {
+            ctx.request_repaint();
+        }
     }
 }
