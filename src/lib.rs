@@ -10,7 +10,8 @@
 //!
 //! Layers, bottom up: [`math`] and [`sampling`] are pure and tested against closed forms; [`scene`] loads
 //! triangles, Phong materials, emissive triangles and a camera and builds the BVH; [`render`] runs the estimators
-//! over an image, and its [`render::worker`] refines an image in the background. Only [`app`], the egui/eframe
+//! over an image; [`measure`] judges estimates against a reference; [`session`] refines one image or two
+//! (compare mode) and a reference in the background. Only [`app`], the egui/eframe
 //! viewer on top, knows about the UI.
 //!
 //! Conventions: `wo` points towards the viewer, `wi` towards the light; local frames have z = n; uniforms are
@@ -18,6 +19,8 @@
 
 pub mod app;
 pub mod math;
+pub mod measure;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod session;

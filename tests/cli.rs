@@ -618,3 +618,77 @@ fn bare_obj_renders_with_an_automatic_camera() {
     // The automatic camera frames the geometry: some of the lit floor is in view.
     assert!(img.as_raw().iter().any(|&b| b > 0), "the bare OBJ rendered black: the camera misses the geometry?");
 }
+
+// ---------------------------------------------------------------------------------------------------------------
+// bench
+// ---------------------------------------------------------------------------------------------------------------
+
+fn bench_args(out: &Path, extra: &[&str]) -> Vec<OsString> {
+    let mut args: Vec<OsString> = ["bench", "cornell-box", "--size", "12x12", "--spp", "1,4", "--strategies"]
+        .into_iter()
+        .map(OsString::from)
+        .collect();
+    args.push("cosine,emitter".into());
+    args.extend(["--reference-spp".into(), "16".into(), "--out".into(), out.as_os_str().to_owned()]);
+    args.extend(extra.iter().map(OsString::from));
+    args
+}
+
+/// The RMSE column of bench.csv, per row.
+fn csv_rmse(path: &Path) -> Vec<String> {
+    let text = fs::read_to_string(path).expect("bench.csv");
+    let header: Vec<&str> = text.lines().next().expect("header").split(',').collect();
+    let col = header.iter().position(|h| *h == "rmse").expect("rmse column");
+    text.lines().skip(1).map(|l| l.split(',').nth(col).expect("rmse").to_string()).collect()
+}
+
+#[test]
+fn bench_writes_csv_markdown_plot_and_reference_deterministically() {
+    let dir = TempDir::new().expect("temp dir");
+    let out = dir.path().join("b1");
+    let first = run(bench_args(&out, &[]));
+    assert_success(&first);
+    assert!(stdout(&first).contains("reference: MIS"), "says how the reference was made: {}", stdout(&first));
+    for file in ["bench.csv", "bench.md", "convergence.png", "reference.exr", "reference.var.exr"] {
+        assert!(out.join(file).exists(), "{file} missing");
+    }
+    let rows = csv_rmse(&out.join("bench.csv"));
+    assert_eq!(rows.len(), 4, "two strategies × two budgets");
+    let md = fs::read_to_string(out.join("bench.md")).expect("bench.md");
+    assert!(md.contains("| cosine | 4 |") && md.contains("| emitter | 1 |"), "{md}");
+    assert!(md.contains("Machine:") && md.contains("Most efficient at 4 spp"), "{md}");
+    assert_eq!(image::image_dimensions(out.join("convergence.png")).expect("png").0, 1200);
+
+    // With the saved reference: no new reference, the same errors (only timings differ).
+    let again = dir.path().join("b2");
+    let reference = out.join("reference.exr");
+    let second = run(bench_args(&again, &["--reference", reference.to_str().expect("utf-8")]));
+    assert_success(&second);
+    assert!(!stdout(&second).contains("reference: MIS"));
+    assert_eq!(csv_rmse(&again.join("bench.csv")), rows);
+}
+
+#[test]
+fn bench_bad_input_is_one_line() {
+    let dir = TempDir::new().expect("temp dir");
+    let out = dir.path().join("b");
+    let o = run(bench_args(&out, &["--strategies", "nope"]));
+    assert_one_line_error(&o, &["--strategies"]);
+    let mut zero = bench_args(&out, &[]);
+    let at = zero.iter().position(|a| a == "1,4").expect("spp");
+    zero[at] = "0,4".into();
+    assert_one_line_error(&run(zero), &["--spp"]);
+    let missing = dir.path().join("missing.exr");
+    let o = run(bench_args(&out, &["--reference", missing.to_str().expect("utf-8")]));
+    assert_one_line_error(&o, &["missing.exr"]);
+    // A reference of another size.
+    let small = dir.path().join("small.exr");
+    assert_success(&run(render_args("cornell-box", &small, &[])));
+    let o = run(bench_args(&out, &["--reference", small.to_str().expect("utf-8")]));
+    assert_one_line_error(&o, &["small.exr", "4×4", "12×12"]);
+    // An output folder that cannot be created.
+    let file = dir.path().join("a-file");
+    fs::write(&file, "x").expect("write");
+    let o = run(bench_args(&file.join("sub"), &[]));
+    assert_one_line_error(&o, &["a-file"]);
+}

@@ -7,6 +7,7 @@ use egui_kittest::kittest::Queryable;
 use illumlab::app::Viewer;
 use illumlab::render::{Film, Heuristic, Renderer, Strategy};
 use illumlab::scene::load_scene;
+use illumlab::session::views::View;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -19,7 +20,7 @@ fn viewer() -> Viewer {
 
 fn harness(v: Viewer) -> Harness<'static, Viewer> {
     let mut h =
-        Harness::builder().with_size(egui::vec2(1200.0, 900.0)).build_ui_state(|ui, v: &mut Viewer| v.ui(ui), v);
+        Harness::builder().with_size(egui::vec2(1200.0, 1600.0)).build_ui_state(|ui, v: &mut Viewer| v.ui(ui), v);
     h.step();
     h
 }
@@ -177,4 +178,126 @@ fn mis_controls_reach_the_integrator() {
     step_until(&mut h, "a 3 + 1 split", |v| {
         v.frame().is_some_and(|f| f.settings.mis.light_samples == 3 && f.settings.mis.brdf_samples == 1)
     });
+}
+
+/// Compare mode end to end: enter it, swap A and B, move the wipe (slider and drag), switch budgets, look at the
+/// difference of identical estimators, export.
+#[test]
+fn compare_mode_swap_wipe_budgets_and_export() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut v = viewer();
+    v.set_export_folder(dir.path().join("shots").to_string_lossy().into_owned());
+    v.set_reference_cache(Some(dir.path().join("cache")));
+    v.set_reference_spp(64);
+    let mut h = harness(v);
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+
+    h.get_by_label("Compare A | B (C)").click();
+    h.step();
+    assert!(h.state().is_comparing());
+    step_until(&mut h, "A and B frames", |v| {
+        v.frame().is_some_and(|f| f.spp >= 2) && v.frame_b().is_some_and(|f| f.spp >= 2)
+    });
+    assert_eq!(h.state().frame_b().map(|f| f.settings.strategy), Some(Strategy::Cosine));
+
+    h.get_by_label("Swap A/B (X)").click();
+    h.step();
+    step_until(&mut h, "swapped frames", |v| {
+        v.frame().is_some_and(|f| f.settings.strategy == Strategy::Cosine)
+            && v.frame_b().is_some_and(|f| f.settings.strategy == Strategy::Emitter)
+    });
+
+    h.get_by_role_and_label(Role::Slider, "wipe").set_value_accesskit(0.25);
+    h.step();
+    assert!((h.state().wipe() - 0.25).abs() < 1e-6);
+    // Drag the line itself from a quarter to three quarters of the image.
+    let rect = h.state().image_rect().expect("drawn");
+    let y = rect.center().y;
+    let (from, to) = (rect.min.x + 0.25 * rect.width(), rect.min.x + 0.75 * rect.width());
+    h.hover_at(egui::pos2(from, y));
+    h.step();
+    h.drag_at(egui::pos2(from, y));
+    h.step();
+    for k in 1..=4 {
+        h.hover_at(egui::pos2(from + (to - from) * k as f32 / 4.0, y));
+        h.step();
+    }
+    h.drop_at(egui::pos2(to, y));
+    h.step();
+    assert!((h.state().wipe() - 0.75).abs() < 0.02, "wipe {}", h.state().wipe());
+
+    h.get_by_label("equal time").click();
+    h.step();
+    assert_eq!(h.state().budget(), illumlab::session::worker::Budget::EqualTime);
+    step_until(&mut h, "equal-time frames", |v| {
+        v.frame().is_some_and(|f| f.spp >= 4) && v.frame_b().is_some_and(|f| f.spp >= 2)
+    });
+    h.get_by_label("equal samples").click();
+    h.step();
+    assert_eq!(h.state().budget(), illumlab::session::worker::Budget::EqualSamples);
+
+    step_until(&mut h, "the reference and a recorded run", |v| {
+        v.reference().is_some() && v.history().iter().any(|s| s.points.len() >= 2)
+    });
+    h.get_by_label("Export comparison").click();
+    h.step();
+    let folder = std::fs::read_dir(dir.path().join("shots"))
+        .expect("the export folder was created")
+        .map(|e| e.expect("entry").path())
+        .find(|p| p.is_dir())
+        .expect("a comparison folder");
+    let name = folder.file_name().expect("name").to_string_lossy().into_owned();
+    assert!(name.starts_with("cornell-box-cosine-vs-emitter-"), "{name}");
+    for file in [
+        "split.png",
+        "a.png",
+        "b.png",
+        "a.exr",
+        "b.exr",
+        "std-error-a.png",
+        "relative-variance-b.png",
+        "abs-error-a.png",
+        "fireflies-b.png",
+        "difference-a.png",
+        "convergence.png",
+        "comparison.json",
+    ] {
+        assert!(folder.join(file).exists(), "{file} missing in {name}");
+    }
+    let json = std::fs::read_to_string(folder.join("comparison.json")).expect("sidecar");
+    for key in ["\"budget\"", "\"wipe\"", "\"rmse\"", "\"reference\"", "\"scales\"", "\"cpu_seconds\""] {
+        assert!(json.contains(key), "{key} missing from the sidecar");
+    }
+}
+
+#[test]
+fn identical_estimators_differ_nowhere_and_error_views_switch() {
+    let mut v = viewer();
+    v.configure(illumlab::render::RenderSettings::default(), Some(4), 0.0);
+    let mut h = harness(v);
+    h.key_press(egui::Key::C);
+    h.step();
+    h.get_all_by_role(Role::ComboBox)
+        .find(|n| n.value().as_deref() == Some("cosine"))
+        .expect("B's strategy picker")
+        .click();
+    h.step();
+    h.step();
+    h.get_by_label("emitter").click();
+    h.step();
+    step_until(&mut h, "both lanes at the target", |v| {
+        v.frame_b().is_some_and(|b| b.settings.strategy == Strategy::Emitter && b.spp == 4)
+            && v.frame().is_some_and(|a| a.spp == 4)
+    });
+    let (a, b) = (h.state().frame().expect("A"), h.state().frame_b().expect("B"));
+    assert_eq!(a.radiance, b.radiance, "common random numbers: A − B = 0 everywhere");
+    // The view key cycles image → standard error → relative variance → |I − R| → fireflies → |A − B|.
+    let expected = [View::StdError, View::RelativeVariance, View::AbsError, View::Fireflies, View::Difference];
+    for view in expected {
+        h.key_press(egui::Key::V);
+        h.step();
+        assert_eq!(h.state().view(), view);
+    }
+    h.step();
+    assert_eq!(h.state().view_note(), Some("zero everywhere"));
 }

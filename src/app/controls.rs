@@ -1,4 +1,5 @@
-//! The side panel: scene, strategy, light selection, sampling budget, seed, exposure, Phong material, export.
+//! The side panel: scene, strategy, light selection, comparison, sampling budget, seed, exposure, Phong material,
+//! export.
 
 use super::viewer::Viewer;
 use crate::render::{Heuristic, LightTechnique, Strategy};
@@ -16,6 +17,8 @@ pub fn controls_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     scene_ui(v, ui);
     ui.separator();
     strategy_ui(v, ui);
+    ui.separator();
+    super::compare::compare_ui(v, ui);
     ui.separator();
     sampling_ui(v, ui);
     ui.separator();

@@ -1,6 +1,8 @@
-//! The interactive viewer: a thin egui/eframe shell over [`crate::render::worker`]. Only this module knows egui.
+//! The interactive viewer: a thin egui/eframe shell over [`crate::session`]. Only this module knows egui.
 
+mod compare;
 mod controls;
+mod convergence;
 mod loader;
 mod orbit;
 mod shortcuts;
@@ -20,18 +22,13 @@ pub struct ViewOptions {
     pub exposure: f32,
     /// Image size, overriding the scene's camera.
     pub size: Option<(u32, u32)>,
-}
-
-impl Default for ViewOptions {
-    fn default() -> Self {
-        Self {
-            scene: crate::scene::DEFAULT_SCENE.into(),
-            settings: Default::default(),
-            target_spp: None,
-            exposure: 0.0,
-            size: None,
-        }
-    }
+    /// Compare mode with this strategy as B.
+    pub compare: Option<crate::render::Strategy>,
+    pub budget: crate::session::worker::Budget,
+    pub view: crate::session::views::View,
+    pub reference_spp: u32,
+    /// Open the convergence plot.
+    pub plot: bool,
 }
 
 /// Opens the window, already rendering.
@@ -52,6 +49,16 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
         Box::new(move |cc| {
             let mut viewer = Viewer::with_scene(std::sync::Arc::new(scene));
             viewer.configure(options.settings, options.target_spp, options.exposure);
+            viewer.set_reference_spp(options.reference_spp);
+            viewer.set_budget(options.budget);
+            if let Some(b) = options.compare {
+                viewer.set_strategy_b(b);
+                viewer.set_comparing(true);
+            }
+            viewer.set_view(options.view);
+            if options.plot {
+                viewer.show_convergence_plot();
+            }
             viewer.bind_repaint(cc.egui_ctx.clone());
             Ok(Box::new(viewer))
         }),

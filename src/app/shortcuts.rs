@@ -2,6 +2,7 @@
 
 use super::viewer::Viewer;
 use crate::render::Strategy;
+use crate::session::views::View;
 use egui::Key;
 
 /// Shortcuts and what they do, in the order the help window lists them.
@@ -11,6 +12,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("R", "restart accumulation"),
     ("+ / −", "exposure up / down by half a stop"),
     ("S", "save a screenshot (PNG, EXR, JSON)"),
+    ("C", "compare mode on / off"),
+    ("X", "swap A and B"),
+    ("V", "next view: image, error maps"),
+    ("P", "convergence plot"),
     ("F", "hide / show the panels"),
     ("F1 or ?", "this help"),
     ("left drag", "orbit"),
@@ -47,6 +52,24 @@ pub fn handle(v: &mut Viewer, ui: &mut egui::Ui) {
     }
     if pressed(Key::S) {
         v.screenshot();
+    }
+    if pressed(Key::C) {
+        v.set_comparing(!v.comparing);
+    }
+    if pressed(Key::X) && v.comparing {
+        v.swap_lanes();
+    }
+    if pressed(Key::V) {
+        let views: Vec<View> = View::ALL.into_iter().filter(|w| v.comparing || !w.needs_comparison()).collect();
+        let next = views.iter().position(|w| *w == v.view).map_or(0, |i| (i + 1) % views.len());
+        v.set_view(views[next]);
+    }
+    if pressed(Key::P) {
+        if v.show_plot {
+            v.show_plot = false;
+        } else {
+            v.show_convergence_plot();
+        }
     }
     if pressed(Key::F) {
         v.hide_panels = !v.hide_panels;

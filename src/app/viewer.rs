@@ -2,10 +2,13 @@
 
 use super::loader::Loading;
 use super::orbit;
-use crate::render::snapshot::{display_rgba, write_snapshot};
-use crate::render::worker::{Command, Frame, Worker};
+use crate::measure::{ColorScale, ConvergencePoint, Reference, Series, default_cache_folder, error_vs_reference};
 use crate::render::{RenderSettings, Strategy};
 use crate::scene::{Camera, Material, Scene};
+use crate::session::comparison::{Comparison, write_comparison};
+use crate::session::snapshot::{display_rgba, write_snapshot};
+use crate::session::views::{View, shared_scale, unavailable, view_values};
+use crate::session::worker::{A, B, Budget, Command, Frame, ReferenceStatus, Worker};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -28,8 +31,32 @@ pub struct Viewer {
     pub(super) one_to_one: bool,
     pub(super) selected_material: usize,
     pub(super) frame: Option<Arc<Frame>>,
-    texture: Option<egui::TextureHandle>,
-    /// The texture must be refilled (new frame or new exposure).
+    /// Compare mode: lane B renders `settings_b` beside A.
+    pub(super) comparing: bool,
+    pub(super) settings_b: RenderSettings,
+    pub(super) frame_b: Option<Arc<Frame>>,
+    pub(super) budget: Budget,
+    pub(super) side_by_side: bool,
+    /// Where the split is, as a fraction of the image width (A left, B right).
+    pub(super) wipe: f32,
+    pub(super) view: View,
+    /// The scale of the error maps on display, and why the chosen map cannot be shown (if so).
+    pub(super) scale: Option<ColorScale>,
+    pub(super) view_note: Option<&'static str>,
+    pub(super) reference: ReferenceStatus,
+    pub(super) reference_spp: u32,
+    pub(super) reference_path: String,
+    reference_cache: Option<PathBuf>,
+    /// Convergence runs against the current reference, one per estimator, in the order first seen.
+    pub(super) history: Vec<Series>,
+    pub(super) show_plot: bool,
+    /// The plot shows relative RMSE instead of RMSE.
+    pub(super) plot_relative: bool,
+    /// Where the image (A's, in compare mode) was last drawn, in points.
+    pub(super) image_rect: Option<egui::Rect>,
+    /// Textures of lanes A and B.
+    textures: [Option<egui::TextureHandle>; 2],
+    /// The textures must be refilled (new frame, view or exposure).
     texture_stale: bool,
     pub(super) loading: Option<Loading>,
     pub(super) error: Option<String>,
@@ -74,7 +101,24 @@ impl Viewer {
             one_to_one: false,
             selected_material: 0,
             frame: None,
-            texture: None,
+            comparing: false,
+            settings_b: RenderSettings { strategy: Strategy::Cosine, ..settings },
+            frame_b: None,
+            budget: Budget::EqualSamples,
+            side_by_side: false,
+            wipe: 0.5,
+            view: View::Image,
+            scale: None,
+            view_note: None,
+            reference: ReferenceStatus::Off,
+            reference_spp: 1024,
+            reference_path: String::new(),
+            reference_cache: default_cache_folder(),
+            history: Vec::new(),
+            show_plot: false,
+            plot_relative: true,
+            image_rect: None,
+            textures: [None, None],
             texture_stale: false,
             loading: None,
             error: None,
@@ -97,6 +141,7 @@ impl Viewer {
     /// Sets strategy, light selection, seed, target and exposure (as the `view` command line does).
     pub fn configure(&mut self, settings: RenderSettings, target_spp: Option<u32>, exposure: f32) {
         self.settings = settings;
+        self.settings_b = RenderSettings { strategy: self.settings_b.strategy, ..settings };
         self.target_spp = target_spp;
         self.set_exposure(exposure);
         self.send_restarting(Command::SetSettings(settings));
@@ -123,6 +168,65 @@ impl Viewer {
         self.export_folder = folder.into();
     }
 
+    /// Lane B's newest frame shown (compare mode).
+    pub fn frame_b(&self) -> Option<&Frame> {
+        self.frame_b.as_deref().filter(|_| self.comparing)
+    }
+
+    pub fn is_comparing(&self) -> bool {
+        self.comparing
+    }
+
+    /// The settings of lanes A and B.
+    pub fn lane_settings(&self) -> (RenderSettings, RenderSettings) {
+        (self.settings, self.settings_b)
+    }
+
+    pub fn budget(&self) -> Budget {
+        self.budget
+    }
+
+    pub fn wipe(&self) -> f32 {
+        self.wipe
+    }
+
+    /// The reference, once ready.
+    pub fn reference(&self) -> Option<&Reference> {
+        match &self.reference {
+            ReferenceStatus::Ready { reference, .. } => Some(reference),
+            _ => None,
+        }
+    }
+
+    /// The convergence runs recorded against the current reference.
+    pub fn history(&self) -> &[Series] {
+        &self.history
+    }
+
+    pub fn view(&self) -> View {
+        self.view
+    }
+
+    /// Why the chosen error map is not shown, if it is not (e.g. "zero everywhere").
+    pub fn view_note(&self) -> Option<&'static str> {
+        self.view_note
+    }
+
+    /// Where the image (A's, in compare mode) was last drawn, in points.
+    pub fn image_rect(&self) -> Option<egui::Rect> {
+        self.image_rect
+    }
+
+    /// Samples per pixel of the next reference rendered.
+    pub fn set_reference_spp(&mut self, spp: u32) {
+        self.reference_spp = spp.max(1);
+    }
+
+    /// Where reference renders are cached (`None`: not cached).
+    pub fn set_reference_cache(&mut self, folder: Option<PathBuf>) {
+        self.reference_cache = folder;
+    }
+
     /// True while a scene is loading in the background.
     pub fn is_loading(&self) -> bool {
         self.loading.is_some()
@@ -145,7 +249,7 @@ impl Viewer {
             self.bind_repaint(ui.ctx().clone());
         }
         self.poll_loading();
-        self.take_frame();
+        self.take_frames();
         super::shortcuts::handle(self, ui);
         if !self.hide_panels {
             egui::Panel::bottom("status").show(ui, |ui| super::status::status_ui(self, ui));
@@ -155,6 +259,7 @@ impl Viewer {
         }
         egui::CentralPanel::default().show(ui, |ui| super::viewport::viewport_ui(self, ui));
         super::shortcuts::help_window(self, ui);
+        super::convergence::convergence_window(self, ui);
         if self.loading.is_some() || self.frame.is_none() {
             ui.ctx().request_repaint_after(Duration::from_millis(30));
         }
@@ -175,9 +280,19 @@ impl Viewer {
         }
     }
 
-    /// The newest frame from the worker, if any; refreshes the texture lazily.
-    fn take_frame(&mut self) {
-        if let Some(frame) = self.worker.take_frame() {
+    /// The newest frames and reference from the worker, if any; records convergence; refreshes textures lazily.
+    fn take_frames(&mut self) {
+        if let Some(status) = self.worker.take_reference() {
+            let new_reference = matches!(status, ReferenceStatus::Ready { .. })
+                || !matches!(self.reference, ReferenceStatus::Rendering { .. });
+            if new_reference {
+                self.history.clear();
+            }
+            self.reference = status;
+            self.texture_stale = true;
+        }
+        for lane in [A, B] {
+            let Some(frame) = self.worker.take_lane(lane) else { continue };
             if let Some((sent, generation)) = self.restart_sent
                 && frame.generation >= generation
             {
@@ -188,24 +303,75 @@ impl Viewer {
                     eprintln!("trace: restart-to-frame {ms:.1} ms at {}x{}", frame.width, frame.height);
                 }
             }
-            self.frame = Some(frame);
+            self.record(&frame);
+            if lane == A {
+                self.frame = Some(frame);
+            } else {
+                self.frame_b = Some(frame);
+            }
             self.texture_stale = true;
         }
     }
 
-    /// The texture showing the current frame at the current exposure, updated in place.
-    pub(super) fn texture(&mut self, ctx: &egui::Context) -> Option<&egui::TextureHandle> {
-        let frame = self.frame.as_ref()?;
-        if self.texture_stale || self.texture.is_none() {
-            let size = [frame.width as usize, frame.height as usize];
-            let image = egui::ColorImage::from_rgba_unmultiplied(size, &display_rgba(&frame.radiance, self.exposure));
-            match &mut self.texture {
-                Some(t) => t.set(image, egui::TextureOptions::NEAREST),
-                None => self.texture = Some(ctx.load_texture("film", image, egui::TextureOptions::NEAREST)),
-            }
-            self.texture_stale = false;
+    /// Adds a point to the frame's convergence run (a restarted run starts its series again).
+    fn record(&mut self, frame: &Frame) {
+        let Some(reference) = self.reference() else { return };
+        if frame.preview || frame.spp == 0 || reference.mean.len() != frame.radiance.len() {
+            return;
         }
-        self.texture.as_ref()
+        let metrics = error_vs_reference(&frame.radiance, reference);
+        let point = ConvergencePoint::new(frame.spp, frame.stats.cpu.as_secs_f64(), &metrics);
+        let label = series_label(&frame.settings);
+        let series = match self.history.iter().position(|s| s.label == label) {
+            Some(i) => &mut self.history[i],
+            None => {
+                self.history.push(Series::new(label));
+                self.history.last_mut().expect("just pushed")
+            }
+        };
+        if series.last().is_some_and(|p| p.spp >= frame.spp) {
+            series.points.clear();
+        }
+        series.push(point);
+    }
+
+    /// The textures of A (and B when comparing) in the current view and exposure, updated in place.
+    pub(super) fn textures(&mut self, ctx: &egui::Context) -> [Option<egui::TextureId>; 2] {
+        let frames = [self.frame.clone(), self.frame_b.clone().filter(|_| self.comparing)];
+        if self.texture_stale || self.textures[A].is_none() {
+            self.texture_stale = false;
+            let reference = self.reference().cloned();
+            let reference = reference.as_ref();
+            let values: Vec<Option<Vec<f32>>> = [A, B]
+                .map(|i| {
+                    let f = frames[i].as_deref()?;
+                    view_values(self.view, f, reference, frames[1 - i].as_deref())
+                })
+                .into();
+            let shown: Vec<&[f32]> = values.iter().flatten().map(|v| v.as_slice()).collect();
+            self.scale = shared_scale(&shown);
+            self.view_note = frames[A].as_deref().and_then(|f| unavailable(self.view, f, reference, self.comparing));
+            if self.view_note.is_none() && self.view != View::Image && self.scale.is_none() {
+                self.view_note = Some("zero everywhere");
+            }
+            for i in [A, B] {
+                let Some(frame) = frames[i].as_deref() else { continue };
+                let rgba = match (&values[i], self.scale) {
+                    (Some(v), Some(scale)) if self.view_note.is_none() => scale.colorize(v),
+                    _ => display_rgba(&frame.radiance, self.exposure),
+                };
+                let image =
+                    egui::ColorImage::from_rgba_unmultiplied([frame.width as usize, frame.height as usize], &rgba);
+                match &mut self.textures[i] {
+                    Some(t) => t.set(image, egui::TextureOptions::NEAREST),
+                    None => {
+                        self.textures[i] =
+                            Some(ctx.load_texture(["lane A", "lane B"][i], image, egui::TextureOptions::NEAREST))
+                    }
+                }
+            }
+        }
+        [A, B].map(|i| frames[i].as_ref().and(self.textures[i].as_ref()).map(|t| t.id()))
     }
 
     pub(super) fn set_exposure(&mut self, stops: f32) {
@@ -230,8 +396,115 @@ impl Viewer {
         }
     }
 
+    /// Sends A's settings; B follows A's light selection, MIS settings and seed (its own strategy).
     pub(super) fn apply_settings(&mut self) {
         self.send_restarting(Command::SetSettings(self.settings));
+        let b = RenderSettings { strategy: self.settings_b.strategy, ..self.settings };
+        if b != self.settings_b {
+            self.settings_b = b;
+            self.send_compare();
+        }
+    }
+
+    /// Enters or leaves compare mode; entering asks for a reference if there is none.
+    pub fn set_comparing(&mut self, on: bool) {
+        if self.comparing == on {
+            return;
+        }
+        self.comparing = on;
+        self.frame_b = None;
+        self.send_compare();
+        if on {
+            self.ensure_reference();
+        }
+        self.texture_stale = true;
+    }
+
+    /// Opens the convergence window (asking for a reference if there is none).
+    pub fn show_convergence_plot(&mut self) {
+        self.show_plot = true;
+        self.ensure_reference();
+    }
+
+    pub fn set_strategy_b(&mut self, strategy: Strategy) {
+        if self.settings_b.strategy != strategy {
+            self.settings_b.strategy = strategy;
+            self.send_compare();
+        }
+    }
+
+    /// Swaps the estimators of A and B (both restart; with common random numbers they reconverge identically).
+    pub fn swap_lanes(&mut self) {
+        std::mem::swap(&mut self.settings.strategy, &mut self.settings_b.strategy);
+        self.send_restarting(Command::SetSettings(self.settings));
+        self.send_compare();
+    }
+
+    pub fn set_budget(&mut self, budget: Budget) {
+        if self.budget != budget {
+            self.budget = budget;
+            self.send_restarting(Command::SetBudget(budget));
+        }
+    }
+
+    pub fn set_wipe(&mut self, wipe: f32) {
+        self.wipe = wipe.clamp(0.0, 1.0);
+    }
+
+    pub fn set_view(&mut self, view: View) {
+        if self.view != view {
+            self.view = view;
+            self.texture_stale = true;
+            if view.needs_reference() {
+                self.ensure_reference();
+            }
+        }
+    }
+
+    fn send_compare(&mut self) {
+        let b = self.comparing.then_some(self.settings_b);
+        self.send_restarting(Command::SetCompare(b));
+    }
+
+    /// Asks for a reference (rendered, or from the cache) unless one is ready or on its way.
+    pub(super) fn ensure_reference(&mut self) {
+        if matches!(self.reference, ReferenceStatus::Off | ReferenceStatus::Failed(_)) {
+            self.compute_reference();
+        }
+    }
+
+    pub(super) fn compute_reference(&mut self) {
+        self.worker.send(Command::SetReference { spp: Some(self.reference_spp), cache: self.reference_cache.clone() });
+        self.reference = ReferenceStatus::Rendering { spp: 0, target: self.reference_spp, elapsed: Duration::ZERO };
+    }
+
+    pub(super) fn load_reference(&mut self, path: PathBuf) {
+        self.worker.send(Command::LoadReference(path));
+    }
+
+    /// Writes the comparison (split, both images, error maps, plot, sidecar); the outcome is shown, never fatal.
+    pub fn export_comparison(&mut self) {
+        let (Some(a), Some(b)) = (self.frame.clone(), self.frame_b.clone().filter(|_| self.comparing)) else {
+            self.message = Some("nothing to compare yet".into());
+            return;
+        };
+        let reference = self.reference().cloned();
+        let comparison = Comparison {
+            a: &a,
+            b: &b,
+            reference: reference.as_ref(),
+            series: &self.history,
+            budget: self.budget,
+            wipe: self.wipe,
+            exposure: self.exposure,
+        };
+        match write_comparison(&comparison, &PathBuf::from(&self.export_folder)) {
+            Ok(folder) => {
+                self.message = Some(format!("saved the comparison in {}", folder.display()));
+                self.error = None;
+            }
+            Err(e) => self.error = Some(format!("comparison not saved: {e}")),
+        }
     }
 
     pub(super) fn set_camera(&mut self, camera: Camera) {
@@ -311,6 +584,19 @@ impl Viewer {
         self.worker.send(Command::SetSppPerPass(self.spp_per_pass));
         self.worker.send(Command::SetTargetSpp(self.target_spp));
     }
+}
+
+/// How a run is named in the convergence plot: the strategy, and what else distinguishes its estimator.
+pub(super) fn series_label(s: &RenderSettings) -> String {
+    let mut label = s.strategy.name().to_string();
+    if s.strategy == Strategy::Mis {
+        let m = s.mis;
+        label += &format!(" ({}, {}, {}+{})", m.light.name(), m.heuristic.name(), m.light_samples, m.brdf_samples);
+    }
+    if s.strategy.light_technique().is_some() || s.strategy == Strategy::Mis {
+        label += &format!(" [{}]", s.light_selection.name());
+    }
+    label
 }
 
 /// A callback for other threads that asks the bound context, if any, to repaint.

@@ -1,6 +1,8 @@
 //! The film: per pixel, the sum and the sum of squares of the accepted samples, in f64 so that 10⁵ samples still
-//! average correctly, and their count. Non-finite samples are never added: the pass counts them instead.
+//! average correctly, and their count; and the largest single sample, for the firefly map. Non-finite samples are
+//! never added: the pass counts them instead.
 
+use crate::math::luminance;
 use glam::{DVec3, Vec3};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -8,6 +10,8 @@ pub struct PixelAccum {
     pub sum: DVec3,
     pub sum_sq: DVec3,
     pub n: u32,
+    /// Luminance of the largest single sample.
+    pub max_luminance: f32,
 }
 
 impl PixelAccum {
@@ -17,6 +21,16 @@ impl PixelAccum {
         self.sum += v;
         self.sum_sq += v * v;
         self.n += 1;
+        self.max_luminance = self.max_luminance.max(luminance(v.as_vec3()));
+    }
+
+    /// Adds the samples accumulated in `other`.
+    #[inline]
+    pub fn merge(&mut self, other: &PixelAccum) {
+        self.sum += other.sum;
+        self.sum_sq += other.sum_sq;
+        self.n += other.n;
+        self.max_luminance = self.max_luminance.max(other.max_luminance);
     }
 
     /// The pixel estimate: the sample mean.
@@ -33,6 +47,28 @@ impl PixelAccum {
         }
         let n = self.n as f64;
         ((self.sum_sq - self.sum * self.sum / n) / (n - 1.0)).max(DVec3::ZERO)
+    }
+
+    /// The standard error of the mean, `sqrt(σ̂²/N)`, as the root mean square over R, G, B.
+    #[inline]
+    pub fn std_error(&self) -> f64 {
+        if self.n < 2 { 0.0 } else { (self.variance().element_sum() / 3.0 / self.n as f64).sqrt() }
+    }
+
+    /// The relative variance of one sample, `σ̂² / (μ̂² + ε)` averaged over R, G, B with ε = 10⁻⁴: the number of
+    /// samples needed for 100% relative error. Dimensionless, so dark and bright regions compare.
+    #[inline]
+    pub fn relative_variance(&self) -> f64 {
+        let m = self.mean();
+        (self.variance() / (m * m + DVec3::splat(1e-4))).element_sum() / 3.0
+    }
+
+    /// The firefly measure: the share of the pixel's luminance sum that its largest single sample carries, in
+    /// [1/N, 1]. Near 1/N the samples are alike; near 1 one rare sample makes the pixel.
+    #[inline]
+    pub fn largest_share(&self) -> f64 {
+        let total = luminance(self.sum.as_vec3()) as f64;
+        if self.n == 0 || !(total > 0.0) { 0.0 } else { (self.max_luminance as f64 / total).min(1.0) }
     }
 }
 
@@ -84,6 +120,18 @@ mod tests {
         }
         assert_eq!(p.mean(), DVec3::splat(2.5));
         assert!((p.variance().x - 5.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn error_measures() {
+        let mut p = PixelAccum::default();
+        for v in [1.0, 1.0, 1.0, 5.0] {
+            p.add(Vec3::splat(v));
+        }
+        assert!((p.std_error() - (4.0f64 / 4.0).sqrt()).abs() < 1e-9, "σ̂² = 4, N = 4");
+        assert!((p.relative_variance() - 4.0 / (4.0 + 1e-4)).abs() < 1e-9);
+        assert!((p.largest_share() - 5.0 / 8.0).abs() < 1e-6);
+        assert_eq!(PixelAccum::default().largest_share(), 0.0);
     }
 
     #[test]

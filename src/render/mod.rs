@@ -5,13 +5,11 @@ mod film;
 mod output;
 mod pass;
 mod shading;
-pub mod snapshot;
 pub mod strategy;
-pub mod worker;
 
 pub use estimator::estimate_direct;
 pub use film::{Film, PixelAccum};
-pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image};
+pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;
 pub use strategy::{DirectionSample, Heuristic, LightTechnique, MisSettings, Strategy, Target};

@@ -60,14 +60,30 @@ pub fn write_image(film: &Film, path: &Path, exposure: f32) -> Result<(), Output
         OutputFormat::Png => {
             let scale = exposure.exp2();
             let bytes: Vec<u8> = means.iter().flat_map(|c| srgb_bytes(*c * scale)).collect();
-            image::RgbImage::from_raw(film.width, film.height, bytes)
-                .ok_or_else(|| "image size mismatch".to_string())
-                .and_then(|img| img.save_with_format(&tmp, image::ImageFormat::Png).map_err(|e| e.to_string()))
+            save_png(&tmp, film.width, film.height, bytes, image::ColorType::Rgb8)
         }
     };
-    let result = result.and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    finish(path, &tmp, result)
+}
+
+/// Writes 8-bit RGBA pixels (row 0 at the top) as a PNG, atomically.
+pub fn write_png_rgba(path: &Path, width: u32, height: u32, rgba: Vec<u8>) -> Result<(), OutputError> {
+    let tmp = temp_path(path);
+    finish(path, &tmp, save_png(&tmp, width, height, rgba, image::ColorType::Rgba8))
+}
+
+fn save_png(to: &Path, width: u32, height: u32, bytes: Vec<u8>, color: image::ColorType) -> Result<(), String> {
+    if bytes.len() != width as usize * height as usize * color.bytes_per_pixel() as usize {
+        return Err("image size mismatch".into());
+    }
+    image::save_buffer_with_format(to, &bytes, width, height, color, image::ImageFormat::Png).map_err(|e| e.to_string())
+}
+
+/// Renames the written temporary file to `path`, or removes it and reports the failure.
+fn finish(path: &Path, tmp: &Path, written: Result<(), String>) -> Result<(), OutputError> {
+    let result = written.and_then(|()| std::fs::rename(tmp, path).map_err(|e| e.to_string()));
     if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
+        let _ = std::fs::remove_file(tmp);
         return Err(OutputError::Write(path.to_path_buf(), e));
     }
     Ok(())

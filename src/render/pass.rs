@@ -6,8 +6,10 @@ use super::strategy::MisSettings;
 use super::{Film, ShadingPoint, Strategy, estimate_direct};
 use crate::math::SampleRng;
 use crate::scene::{Camera, CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
+use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
+use std::time::Duration;
 
 /// What a render is a function of, besides the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -39,6 +41,8 @@ pub struct PassStats {
     pub rays: u64,
     /// Non-finite samples dropped.
     pub non_finite: u64,
+    /// CPU time spent on the samples, summed over threads (each row's thread CPU clock).
+    pub cpu: Duration,
 }
 
 impl std::ops::AddAssign for PassStats {
@@ -46,6 +50,7 @@ impl std::ops::AddAssign for PassStats {
         self.samples += o.samples;
         self.rays += o.rays;
         self.non_finite += o.non_finite;
+        self.cpu += o.cpu;
     }
 }
 
@@ -94,6 +99,7 @@ impl<'a> Renderer<'a> {
                 if cancelled() {
                     return stats;
                 }
+                let cpu = ThreadTime::now();
                 for (x, acc) in row.iter_mut().enumerate() {
                     let pixel = y as u64 * width as u64 + x as u64;
                     for s in first..first + count {
@@ -107,6 +113,7 @@ impl<'a> Renderer<'a> {
                     }
                     stats.samples += count as u64;
                 }
+                stats.cpu = cpu.elapsed();
                 stats
             })
             .reduce(PassStats::default, |mut a, b| {

@@ -2,8 +2,8 @@
 //! sidecar with everything needed to reproduce it. File names say scene, strategy and spp; an existing file is
 //! never overwritten (a counter is appended).
 
-use super::output::{OutputError, srgb_bytes};
 use super::worker::Frame;
+use crate::render::{OutputError, srgb_bytes};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -65,9 +65,9 @@ pub fn write_snapshot(frame: &Frame, folder: &Path, exposure: f32) -> Result<Sna
         .find(|p| !p.png.exists() && !p.exr.exists() && !p.json.exists())
         .ok_or_else(|| SnapshotError::Folder(folder.to_path_buf(), "no free file name".into()))?;
 
-    let film_like = super::Film::from_means(frame.width, frame.height, &frame.radiance);
-    super::write_image(&film_like, &paths.exr, 0.0)?;
-    super::write_image(&film_like, &paths.png, exposure)?;
+    let film_like = crate::render::Film::from_means(frame.width, frame.height, &frame.radiance);
+    crate::render::write_image(&film_like, &paths.exr, 0.0)?;
+    crate::render::write_image(&film_like, &paths.png, exposure)?;
     let c = frame.camera;
     let sidecar = Sidecar {
         scene: &frame.scene_name,

@@ -1,4 +1,6 @@
-//! The headless command line: `render` and `strategies`.
+//! The headless command line: `render`, `bench` and `strategies`.
+
+mod bench;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -7,6 +9,8 @@ use illumlab::render::{
     write_image,
 };
 use illumlab::scene::{LightSelection, load_scene};
+use illumlab::session::views::View;
+use illumlab::session::worker::Budget;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -23,6 +27,9 @@ pub enum Command {
     View(ViewArgs),
     /// Render a scene with one strategy to an EXR (linear) or PNG (sRGB) file.
     Render(RenderArgs),
+    /// Measure the speed/accuracy trade: every strategy at several budgets against a reference; writes CSV,
+    /// markdown and a log–log plot of RMSE against spp and seconds.
+    Bench(bench::BenchArgs),
     /// List the sampling strategies: name, then a one-line description.
     Strategies,
 }
@@ -81,6 +88,21 @@ pub struct ViewArgs {
     pub size: Option<(u32, u32)>,
     #[command(flatten)]
     pub mis: MisArgs,
+    /// Open in compare mode with this strategy as B (A is --strategy).
+    #[arg(long, value_parser = parse_strategy)]
+    pub compare: Option<Strategy>,
+    /// Compare mode's budget: equal-samples or equal-time.
+    #[arg(long, value_parser = parse_budget, default_value = "equal-samples")]
+    pub budget: Budget,
+    /// What to show: image, std-error, relative-variance, abs-error, fireflies or difference.
+    #[arg(long, value_parser = parse_view, default_value = "image")]
+    pub view: View,
+    /// Samples per pixel of the reference the error views and the plot measure against.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
+    pub reference_spp: u32,
+    /// Open the convergence plot.
+    #[arg(long)]
+    pub plot: bool,
 }
 
 /// The options of `--strategy mis`.
@@ -98,7 +120,7 @@ pub struct MisArgs {
 }
 
 impl MisArgs {
-    fn settings(&self) -> MisSettings {
+    pub(crate) fn settings(&self) -> MisSettings {
         MisSettings {
             light: self.mis_light,
             heuristic: self.mis_heuristic,
@@ -125,19 +147,34 @@ fn parse_mis_samples(s: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_strategy(s: &str) -> Result<Strategy, String> {
+pub(crate) fn parse_strategy(s: &str) -> Result<Strategy, String> {
     Strategy::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = Strategy::ALL.iter().map(|s| s.name()).collect();
         format!("unknown strategy (one of: {})", names.join(", "))
     })
 }
 
-fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
+fn parse_budget(s: &str) -> Result<Budget, String> {
+    match s {
+        "equal-samples" => Ok(Budget::EqualSamples),
+        "equal-time" => Ok(Budget::EqualTime),
+        _ => Err("unknown budget (equal-samples or equal-time)".into()),
+    }
+}
+
+fn parse_view(s: &str) -> Result<View, String> {
+    View::ALL.into_iter().find(|v| v.slug() == s).ok_or_else(|| {
+        let names: Vec<&str> = View::ALL.iter().map(|v| v.slug()).collect();
+        format!("unknown view (one of: {})", names.join(", "))
+    })
+}
+
+pub(crate) fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
     LightSelection::from_name(s)
         .ok_or_else(|| "unknown light selection (one of: uniform, area, power, contribution)".to_string())
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or("expected WxH, e.g. 256x256")?;
     let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|&v| (1..=16384).contains(&v));
     match (parse(w), parse(h)) {
@@ -163,6 +200,7 @@ pub fn run(command: Command) -> Result<()> {
             Ok(())
         }
         Command::Render(args) => render(args),
+        Command::Bench(args) => bench::bench(args),
         Command::View(args) if !args.exposure.is_finite() => bail!("--exposure must be a finite number of stops"),
         Command::View(args) => illumlab::app::run(illumlab::app::ViewOptions {
             scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),
@@ -175,6 +213,11 @@ pub fn run(command: Command) -> Result<()> {
             target_spp: args.target_spp,
             exposure: args.exposure,
             size: args.size,
+            compare: args.compare,
+            budget: args.budget,
+            view: args.view,
+            reference_spp: args.reference_spp,
+            plot: args.plot,
         }),
     }
 }
@@ -244,7 +287,7 @@ fn render(args: RenderArgs) -> Result<()> {
 }
 
 /// Samples per pixel per pass: about 2 M samples, so a pass takes some tens of milliseconds.
-fn pass_size(spp: u32, pixels: usize) -> u32 {
+pub(crate) fn pass_size(spp: u32, pixels: usize) -> u32 {
     ((2_000_000 / pixels.max(1)) as u32).clamp(1, spp)
 }
 

@@ -1,0 +1,11 @@
+#!/bin/sh
+# Runs `illumlab bench` on every bundled scene (default budgets 1..256 spp, reference at 4096 spp) and writes
+# docs/bench/<scene>/{bench.csv,bench.md,convergence.png}. Run on an otherwise idle machine: timings are wall-clock.
+set -e
+cd "$(dirname "$0")/.."
+cargo build --release
+for scene in cornell-box near-light veach-mis default; do
+    target/release/illumlab bench "$scene" --out "docs/bench/$scene" "$@"
+done
+# The references are large and reproducible: keep them out of the repository.
+rm -f docs/bench/*/reference.exr docs/bench/*/reference.var.exr

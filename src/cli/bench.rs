@@ -1,0 +1,148 @@
+//! `illumlab bench`: every strategy at several budgets against a reference, written as CSV, markdown and a plot.
+
+use super::{MisArgs, parse_light_selection, parse_size, parse_strategy, pass_size};
+use anyhow::{Context, Result, bail};
+use illumlab::measure::{
+    BenchContext, Reference, machine_description, markdown, reference_settings, run_bench, write_convergence_png,
+    write_csv,
+};
+use illumlab::render::{Film, RenderSettings, Renderer, Strategy, check_output_path};
+use illumlab::scene::{LightSelection, Scene, load_scene};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(clap::Args, Debug)]
+pub struct BenchArgs {
+    /// A scene file or the name of a bundled scene.
+    pub scene: String,
+    /// Strategies to compare, comma-separated (default: all).
+    #[arg(long, value_delimiter = ',', value_parser = parse_strategy)]
+    pub strategies: Vec<Strategy>,
+    /// Budgets in samples per pixel, comma-separated; each strategy renders progressively through them.
+    #[arg(long, value_delimiter = ',', default_value = "1,4,16,64,256", value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub spp: Vec<u32>,
+    /// A reference image (linear EXR of the same size); without it one is rendered and saved in the output folder.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Samples per pixel of a rendered reference (default: 16 × the largest budget).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
+    pub reference_spp: Option<u32>,
+    /// Output folder (created if needed; default: bench-<scene>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Image size WxH, overriding the scene's camera.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
+    pub seed: u64,
+    #[arg(long, value_parser = parse_light_selection, default_value = "power")]
+    pub light_selection: LightSelection,
+    #[command(flatten)]
+    pub mis: MisArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
+    pub threads: Option<u32>,
+}
+
+pub fn bench(args: BenchArgs) -> Result<()> {
+    let mut budgets = args.spp.clone();
+    budgets.sort_unstable();
+    budgets.dedup();
+    let strategies = if args.strategies.is_empty() { Strategy::ALL.to_vec() } else { args.strategies.clone() };
+    let mut scene = load_scene(&args.scene)?;
+    if let Some((w, h)) = args.size {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.name);
+    }
+    let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("bench-{}", scene.name)));
+    std::fs::create_dir_all(&out).with_context(|| format!("output folder {}", out.display()))?;
+    check_output_path(&out.join("convergence.png"))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .context("cannot start the worker threads")?;
+    let (w, h) = (scene.camera.width, scene.camera.height);
+
+    let (reference, reference_line) = match &args.reference {
+        Some(path) => {
+            let r = Reference::load_exr(path)?;
+            r.check_size(w, h)?;
+            (r, format!("{} (given)", path.display()))
+        }
+        None => {
+            let spp = args.reference_spp.unwrap_or(16 * budgets.last().copied().unwrap_or(1));
+            let r = pool.install(|| render_reference(&scene, spp));
+            let path = out.join("reference.exr");
+            r.save_exr(&path)?;
+            let line = format!(
+                "MIS (projected-solid-angle + BRDF, power heuristic), {spp} spp, rendered in {:.1} s, saved as {}",
+                r.seconds,
+                path.display()
+            );
+            println!("reference: {line}");
+            (r, line)
+        }
+    };
+
+    let base = RenderSettings {
+        strategy: Strategy::Emitter,
+        light_selection: args.light_selection,
+        seed: args.seed,
+        mis: args.mis.settings(),
+    };
+    let report = pool.install(|| {
+        run_bench(&scene, &reference, base, &strategies, &budgets, |s, spp| {
+            if Some(&spp) == budgets.last() {
+                eprintln!("  {} done", s.name());
+            }
+        })
+    });
+    if budgets.is_empty() || report.rows.is_empty() {
+        bail!("nothing to measure");
+    }
+    let machine = machine_description();
+    let threads = pool.current_num_threads();
+    let ctx = BenchContext {
+        scene: &scene.name,
+        width: w,
+        height: h,
+        reference: &reference_line,
+        machine: &format!("{machine} ({threads} used)"),
+    };
+    let md = markdown(&report, &ctx);
+    write(&out.join("bench.md"), md.as_bytes())?;
+    write_csv(&out.join("bench.csv"), &report).map_err(anyhow::Error::msg)?;
+    let title = format!("{} {w}x{h}: RMSE against the reference", scene.name);
+    write_convergence_png(&out.join("convergence.png"), &title, &report.series, report.reference_rmse)?;
+    println!("{md}");
+    println!("wrote {}/bench.csv, bench.md, convergence.png", out.display());
+    Ok(())
+}
+
+/// Renders the reference with [`reference_settings`] in passes of a few samples.
+fn render_reference(scene: &Scene, spp: u32) -> Reference {
+    let renderer = Renderer::new(scene, reference_settings());
+    let mut film = Film::new(scene.camera.width, scene.camera.height);
+    let chunk = pass_size(spp, film.pixels.len());
+    let bar = indicatif::ProgressBar::new(spp as u64).with_style(
+        indicatif::ProgressStyle::with_template("reference {bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")
+            .expect("valid template"),
+    );
+    let start = Instant::now();
+    let mut done = 0;
+    while done < spp {
+        let count = chunk.min(spp - done);
+        renderer.render_pass(&mut film, done, count, &|| false);
+        done += count;
+        bar.set_position(done as u64);
+    }
+    bar.finish_and_clear();
+    Reference::from_film(&film, start.elapsed().as_secs_f64())
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+}

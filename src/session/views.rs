@@ -1,0 +1,114 @@
+//! What can be shown of a lane: the image, or one of its per-pixel error maps. Maps are scalars drawn in false
+//! colour ([`ColorScale`]) on one scale for both lanes, so equal colours mean equal values across the split.
+
+use super::worker::Frame;
+use crate::measure::{ColorScale, Reference, absolute_error_map};
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum View {
+    #[default]
+    Image,
+    /// `sqrt(σ̂²/N)`: how far the pixel may still be from its expectation.
+    StdError,
+    /// `σ̂²/μ̂²`: the estimator's relative variance per sample, independent of N.
+    RelativeVariance,
+    /// `|I − R|` against the reference.
+    AbsError,
+    /// The largest single sample's share of the pixel's sum.
+    Fireflies,
+    /// `|A − B|`: with common random numbers, only where the estimators differ.
+    Difference,
+}
+
+impl View {
+    pub const ALL: [View; 6] =
+        [View::Image, View::StdError, View::RelativeVariance, View::AbsError, View::Fireflies, View::Difference];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Image => "image",
+            View::StdError => "standard error",
+            View::RelativeVariance => "relative variance",
+            View::AbsError => "|estimate - reference|",
+            View::Fireflies => "fireflies",
+            View::Difference => "|A - B|",
+        }
+    }
+
+    /// A file-name-safe name.
+    pub fn slug(self) -> &'static str {
+        match self {
+            View::Image => "image",
+            View::StdError => "std-error",
+            View::RelativeVariance => "relative-variance",
+            View::AbsError => "abs-error",
+            View::Fireflies => "fireflies",
+            View::Difference => "difference",
+        }
+    }
+
+    /// One line on what the map shows, for the legend.
+    pub fn description(self) -> &'static str {
+        match self {
+            View::Image => "the accumulated estimate",
+            View::StdError => "standard error of the mean, sqrt(s^2/N), from the sum of squares (radiance)",
+            View::RelativeVariance => "variance of one sample over the squared mean: samples needed for 100% error",
+            View::AbsError => "absolute error against the reference (radiance)",
+            View::Fireflies => "share of the pixel's sum carried by its largest single sample (1/N .. 1)",
+            View::Difference => "absolute difference of A and B (radiance): zero where the estimators agree",
+        }
+    }
+
+    pub fn needs_reference(self) -> bool {
+        self == View::AbsError
+    }
+
+    pub fn needs_comparison(self) -> bool {
+        self == View::Difference
+    }
+}
+
+/// The per-pixel values of `view` for `frame`; `None` for the image, for a preview, or when the reference (or the
+/// other lane) needed is missing or has another size.
+pub fn view_values(
+    view: View,
+    frame: &Frame,
+    reference: Option<&Reference>,
+    other: Option<&Frame>,
+) -> Option<Vec<f32>> {
+    if frame.preview {
+        return None;
+    }
+    match view {
+        View::Image => None,
+        View::StdError => Some(frame.std_error.clone()),
+        View::RelativeVariance => Some(frame.relative_variance.clone()),
+        View::Fireflies => Some(frame.largest_share.clone()),
+        View::AbsError => {
+            let r = reference.filter(|r| r.mean.len() == frame.radiance.len())?;
+            Some(absolute_error_map(&frame.radiance, r))
+        }
+        View::Difference => {
+            let o = other.filter(|o| o.radiance.len() == frame.radiance.len() && !o.preview)?;
+            Some(frame.radiance.iter().zip(&o.radiance).map(|(a, b)| (*a - *b).abs().element_sum() / 3.0).collect())
+        }
+    }
+}
+
+/// Why `view` cannot be shown yet, if it cannot.
+pub fn unavailable(view: View, frame: &Frame, reference: Option<&Reference>, comparing: bool) -> Option<&'static str> {
+    match view {
+        _ if frame.preview && view != View::Image => Some("after the first full pass"),
+        View::AbsError if reference.is_none() => Some("no reference yet: compute or load one"),
+        View::AbsError if reference.is_some_and(|r| r.mean.len() != frame.radiance.len()) => {
+            Some("the reference has another size")
+        }
+        View::Difference if !comparing => Some("only in compare mode"),
+        _ => None,
+    }
+}
+
+/// One scale for all the maps shown together. A map of zeros (identical lanes) has none.
+pub fn shared_scale(maps: &[&[f32]]) -> Option<ColorScale> {
+    ColorScale::fit(maps.iter().copied())
+}

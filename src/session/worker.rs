@@ -1,0 +1,788 @@
+//! The background integrator: a thread that owns the films and refines them pass after pass.
+//!
+//! It renders one image (lane A) or, in compare mode, two (lanes A and B: two estimators of the same scene and
+//! camera, with the same per-pixel random streams), and optionally a reference in between. The UI sends
+//! [`Command`]s over a channel and takes the newest [`Frame`] of each lane from latest-value slots: it never
+//! waits for a pass and never receives stale frames. A command that changes what a lane converges to bumps that
+//! lane's generation at once; the lane's pass in flight polls it row by row, so the new setting shows in the next
+//! frame. The worker calls `notify` after every pass (the app binds it to `request_repaint`).
+//!
+//! Budgets in compare mode: **equal samples** runs the lane with fewer spp next, so both reach the same spp;
+//! **equal time** runs the lane with less CPU time next (each row's thread CPU clock, summed), so both get the
+//! same time within one pass and each shows its own spp. With a target spp, equal time stops each lane at the CPU
+//! time the first one needed to reach the target.
+
+use crate::measure::{Reference, ReferenceOrigin, load_cached, reference_settings, store_cached};
+use crate::render::{Film, PassStats, RenderSettings, Renderer};
+use crate::scene::{Camera, Material, Scene};
+use glam::Vec3;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+/// Lane indices.
+pub const A: usize = 0;
+pub const B: usize = 1;
+/// The reference's index among the generation counters.
+const R: usize = 2;
+
+/// How compare mode shares the integrator between A and B.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Budget {
+    #[default]
+    EqualSamples,
+    EqualTime,
+}
+
+impl Budget {
+    pub fn name(self) -> &'static str {
+        match self {
+            Budget::EqualSamples => "equal samples",
+            Budget::EqualTime => "equal time",
+        }
+    }
+}
+
+/// What the UI can ask of the worker.
+pub enum Command {
+    /// Render another scene (its camera included).
+    SetScene(Arc<Scene>),
+    /// Lane A's settings.
+    SetSettings(RenderSettings),
+    /// Compare mode: lane B's settings; `None` renders A alone.
+    SetCompare(Option<RenderSettings>),
+    SetBudget(Budget),
+    SetCamera(Camera),
+    SetMaterial {
+        index: usize,
+        material: Material,
+    },
+    /// Samples per pixel taken in one pass (how often a frame is published).
+    SetSppPerPass(u32),
+    /// Stop refining at this many samples per pixel (`None`: never).
+    SetTargetSpp(Option<u32>),
+    Pause(bool),
+    /// Discard the films and start again (the reference stays).
+    Restart,
+    /// Render a reference at this many spp (or take it from the cache folder, and store it there when done);
+    /// `None` forgets the reference.
+    SetReference {
+        spp: Option<u32>,
+        cache: Option<PathBuf>,
+    },
+    /// Use the reference in this EXR file (with its `.var.exr` sibling if present).
+    LoadReference(PathBuf),
+    Quit,
+}
+
+impl Command {
+    /// The generation counters the command bumps: lanes and reference whose image it changes.
+    fn resets(&self) -> &'static [usize] {
+        match self {
+            Command::SetScene(_) | Command::SetCamera(_) | Command::SetMaterial { .. } => &[A, B, R],
+            Command::Restart | Command::SetBudget(_) => &[A, B],
+            Command::SetSettings(_) => &[A],
+            Command::SetCompare(_) => &[B],
+            Command::SetReference { .. } | Command::LoadReference(_) => &[R],
+            _ => &[],
+        }
+    }
+}
+
+/// A snapshot of one lane's film after a pass.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// [`A`] or [`B`].
+    pub lane: usize,
+    /// Increases with every restart of this lane; frames of one generation refine the same image.
+    pub generation: u64,
+    pub width: u32,
+    pub height: u32,
+    /// Mean radiance per pixel (linear RGB), row 0 at the top.
+    pub radiance: Vec<Vec3>,
+    /// Per pixel: standard error of the mean, relative variance, largest single sample's share of the sum (see
+    /// [`crate::render::PixelAccum`]). Empty in a preview.
+    pub std_error: Vec<f32>,
+    pub relative_variance: Vec<f32>,
+    pub largest_share: Vec<f32>,
+    pub spp: u32,
+    pub passes: u32,
+    /// Wall-clock rendering time since the restart (pauses excluded).
+    pub elapsed: Duration,
+    /// Totals since the restart, CPU time included.
+    pub stats: PassStats,
+    pub settings: RenderSettings,
+    pub scene_name: String,
+    pub camera: Camera,
+    /// A half-resolution, one-sample preview published right after a restart, before the first full pass.
+    pub preview: bool,
+}
+
+/// The reference, as the worker last reported it.
+#[derive(Clone, Debug)]
+pub enum ReferenceStatus {
+    /// None asked for.
+    Off,
+    Rendering {
+        spp: u32,
+        target: u32,
+        elapsed: Duration,
+    },
+    /// Ready; `note` says where it came from or why it was not cached.
+    Ready {
+        reference: Arc<Reference>,
+        note: String,
+    },
+    Failed(String),
+}
+
+/// Handle to the integrator thread; dropping it stops the thread.
+pub struct Worker {
+    commands: Sender<Command>,
+    latest: Arc<Slots>,
+    shared: Arc<Shared>,
+    thread: Option<JoinHandle<()>>,
+}
+
+/// Latest-value slots, one per lane, and the reference's.
+#[derive(Default)]
+struct Slots {
+    frames: [Mutex<Option<Arc<Frame>>>; 2],
+    reference: Mutex<Option<ReferenceStatus>>,
+}
+
+/// Counters the UI bumps and passes poll.
+#[derive(Default)]
+struct Shared {
+    /// Bumped by every command that restarts something.
+    generation: AtomicU64,
+    /// Per lane and reference: the generation of the last command that restarted it.
+    resets: [AtomicU64; 3],
+}
+
+impl Worker {
+    /// Starts rendering `scene` at once. `threads`: size of the pass's thread pool (leave the UI a core).
+    pub fn spawn(
+        scene: Arc<Scene>,
+        settings: RenderSettings,
+        threads: usize,
+        notify: impl Fn() + Send + 'static,
+    ) -> Self {
+        let (commands, rx) = channel();
+        let latest = Arc::new(Slots::default());
+        let shared = Arc::new(Shared::default());
+        let state = State::new(scene, settings, latest.clone(), shared.clone(), Box::new(notify));
+        let thread =
+            std::thread::Builder::new().name("integrator".into()).spawn(move || state.run(rx, threads.max(1))).ok();
+        Self { commands, latest, shared, thread }
+    }
+
+    /// Sends a command; one that changes an image cancels that image's pass in flight first.
+    pub fn send(&self, command: Command) {
+        let resets = command.resets();
+        if !resets.is_empty() {
+            let g = self.shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
+            for &i in resets {
+                self.shared.resets[i].store(g, Ordering::SeqCst);
+            }
+        }
+        let _ = self.commands.send(command);
+    }
+
+    /// Lane A's newest frame, if one was published since the last call.
+    pub fn take_frame(&self) -> Option<Arc<Frame>> {
+        self.take_lane(A)
+    }
+
+    /// The newest frame of `lane` ([`A`] or [`B`]), if one was published since the last call.
+    pub fn take_lane(&self, lane: usize) -> Option<Arc<Frame>> {
+        self.latest.frames[lane].lock().ok()?.take()
+    }
+
+    /// The reference's status, if it changed since the last call.
+    pub fn take_reference(&self) -> Option<ReferenceStatus> {
+        self.latest.reference.lock().ok()?.take()
+    }
+
+    /// The current generation: frames of this generation or later show every command sent so far.
+    pub fn generation(&self) -> u64 {
+        self.shared.generation.load(Ordering::SeqCst)
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        let g = self.shared.generation.fetch_add(1, Ordering::SeqCst) + 1;
+        self.shared.resets.iter().for_each(|r| r.store(g, Ordering::SeqCst));
+        let _ = self.commands.send(Command::Quit);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// One image being refined.
+struct Lane {
+    settings: RenderSettings,
+    film: Film,
+    spp: u32,
+    passes: u32,
+    stats: PassStats,
+    elapsed: Duration,
+    /// The generation this film belongs to.
+    generation: u64,
+    /// Whether the preview of this generation was published.
+    previewed: bool,
+}
+
+impl Lane {
+    fn new(settings: RenderSettings, camera: &Camera) -> Self {
+        Self {
+            settings,
+            film: Film::new(camera.width, camera.height),
+            spp: 0,
+            passes: 0,
+            stats: PassStats::default(),
+            elapsed: Duration::ZERO,
+            generation: 0,
+            previewed: false,
+        }
+    }
+
+    fn reset(&mut self, camera: &Camera, generation: u64) {
+        if (self.film.width, self.film.height) == (camera.width, camera.height) {
+            self.film.clear();
+        } else {
+            self.film = Film::new(camera.width, camera.height);
+        }
+        self.spp = 0;
+        self.passes = 0;
+        self.stats = PassStats::default();
+        self.elapsed = Duration::ZERO;
+        self.generation = generation;
+        self.previewed = false;
+    }
+}
+
+/// The reference being rendered.
+struct ReferenceJob {
+    target: u32,
+    cache: Option<PathBuf>,
+    film: Film,
+    spp: u32,
+    elapsed: Duration,
+}
+
+/// Everything the worker thread owns.
+struct State {
+    scene: Arc<Scene>,
+    lanes: [Lane; 2],
+    comparing: bool,
+    budget: Budget,
+    /// Equal time with a target: the CPU time the first lane needed to reach it.
+    time_budget: Option<Duration>,
+    spp_per_pass: u32,
+    target: Option<u32>,
+    paused: bool,
+    /// What the reference should be: the spp to render and where to cache it, or a file.
+    reference_spp: Option<u32>,
+    reference_cache: Option<PathBuf>,
+    reference_file: Option<PathBuf>,
+    job: Option<ReferenceJob>,
+    /// The reference's generation, to discard a pass cancelled by a scene change.
+    reference_generation: u64,
+    /// Passes run since the reference job started: it gets every other one while lanes are busy.
+    turn: u64,
+    latest: Arc<Slots>,
+    shared: Arc<Shared>,
+    notify: Box<dyn Fn() + Send>,
+}
+
+impl State {
+    fn new(
+        scene: Arc<Scene>,
+        settings: RenderSettings,
+        latest: Arc<Slots>,
+        shared: Arc<Shared>,
+        notify: Box<dyn Fn() + Send>,
+    ) -> Self {
+        let lanes = [Lane::new(settings, &scene.camera), Lane::new(settings, &scene.camera)];
+        Self {
+            scene,
+            lanes,
+            comparing: false,
+            budget: Budget::EqualSamples,
+            time_budget: None,
+            spp_per_pass: 1,
+            target: None,
+            paused: false,
+            reference_spp: None,
+            reference_cache: None,
+            reference_file: None,
+            job: None,
+            reference_generation: 0,
+            turn: 0,
+            latest,
+            shared,
+            notify,
+        }
+    }
+
+    fn lane_count(&self) -> usize {
+        if self.comparing { 2 } else { 1 }
+    }
+
+    fn lane_idle(&self, i: usize) -> bool {
+        let lane = &self.lanes[i];
+        if self.paused {
+            return true;
+        }
+        match (self.comparing, self.budget) {
+            (true, Budget::EqualTime) => self.time_budget.is_some_and(|t| lane.stats.cpu >= t),
+            _ => self.target.is_some_and(|t| lane.spp >= t),
+        }
+    }
+
+    /// The lane to refine next, by the budget: fewer spp, or less CPU time (A on ties).
+    fn next_lane(&self) -> Option<usize> {
+        let busy = (0..self.lane_count()).filter(|&i| !self.lane_idle(i));
+        match self.budget {
+            Budget::EqualSamples => busy.min_by_key(|&i| self.lanes[i].spp),
+            Budget::EqualTime => busy.min_by_key(|&i| self.lanes[i].stats.cpu),
+        }
+    }
+
+    fn reference_pending(&self) -> bool {
+        !self.paused && self.job.is_some()
+    }
+
+    /// `threads` run the passes; the first pass after a restart uses every core, so that a new setting shows as
+    /// soon as possible (the UI is idle then).
+    fn run(mut self, rx: Receiver<Command>, threads: usize) {
+        let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else { return };
+        let all = std::thread::available_parallelism().map_or(threads, |n| n.get().max(threads));
+        let Ok(first_pool) = rayon::ThreadPoolBuilder::new().num_threads(all).build() else { return };
+        loop {
+            // Apply every pending command; block only when there is nothing to render.
+            let mut changed = false;
+            loop {
+                let nothing_to_do = self.next_lane().is_none() && !self.reference_pending();
+                let command = if nothing_to_do && !changed {
+                    match rx.recv() {
+                        Ok(c) => c,
+                        Err(_) => return,
+                    }
+                } else {
+                    match rx.try_recv() {
+                        Ok(c) => c,
+                        Err(TryRecvError::Empty) => break,
+                        Err(TryRecvError::Disconnected) => return,
+                    }
+                };
+                changed |= !command.resets().is_empty();
+                if !self.apply(command) {
+                    return;
+                }
+            }
+            if changed {
+                self.reset_what_changed();
+            }
+            if let Some(i) = (0..self.lane_count()).find(|&i| !self.lanes[i].previewed && !self.lane_idle(i)) {
+                self.preview(i, &first_pool);
+                continue;
+            }
+            let lane = self.next_lane();
+            let reference_turn = self.reference_pending() && (lane.is_none() || self.turn % 2 == 1);
+            self.turn += 1;
+            match lane {
+                _ if reference_turn => self.reference_pass(if lane.is_none() { &first_pool } else { &pool }),
+                Some(i) => self.pass(i, if self.lanes[i].passes == 0 { &first_pool } else { &pool }),
+                None => {}
+            }
+        }
+    }
+
+    /// Returns false on `Quit`.
+    fn apply(&mut self, command: Command) -> bool {
+        match command {
+            Command::SetScene(scene) => self.scene = scene,
+            Command::SetSettings(s) => self.lanes[A].settings = s,
+            Command::SetCompare(b) => {
+                self.comparing = b.is_some();
+                if let Some(s) = b {
+                    self.lanes[B].settings = s;
+                }
+            }
+            Command::SetBudget(b) => self.budget = b,
+            Command::SetCamera(camera) => Arc::make_mut(&mut self.scene).camera = camera,
+            Command::SetMaterial { index, material } => {
+                if let Some(m) = Arc::make_mut(&mut self.scene).materials.get_mut(index) {
+                    *m = material;
+                }
+            }
+            Command::SetSppPerPass(n) => self.spp_per_pass = n.max(1),
+            Command::SetTargetSpp(t) => {
+                self.target = t;
+                self.time_budget = None;
+            }
+            Command::Pause(p) => self.paused = p,
+            Command::Restart => {}
+            Command::SetReference { spp, cache } => {
+                self.reference_spp = spp;
+                self.reference_cache = cache;
+                self.reference_file = None;
+            }
+            Command::LoadReference(path) => self.reference_file = Some(path),
+            Command::Quit => return false,
+        }
+        true
+    }
+
+    /// Resets every lane (and the reference) whose generation moved.
+    fn reset_what_changed(&mut self) {
+        let camera = self.scene.camera;
+        for i in [A, B] {
+            let g = self.shared.resets[i].load(Ordering::SeqCst);
+            if g != self.lanes[i].generation {
+                self.lanes[i].reset(&camera, g);
+                self.time_budget = None;
+            }
+        }
+        let g = self.shared.resets[R].load(Ordering::SeqCst);
+        if g != self.reference_generation {
+            self.reference_generation = g;
+            self.start_reference();
+        }
+    }
+
+    /// Sets up the reference for the current scene: from a file, from the cache, or a render job.
+    fn start_reference(&mut self) {
+        self.job = None;
+        let (w, h) = (self.scene.camera.width, self.scene.camera.height);
+        if let Some(path) = &self.reference_file {
+            let status = match Reference::load_exr(path).and_then(|r| r.check_size(w, h).map(|()| r)) {
+                Ok(r) => ReferenceStatus::Ready { reference: Arc::new(r), note: format!("from {}", path.display()) },
+                Err(e) => ReferenceStatus::Failed(e.to_string()),
+            };
+            // A file matches one camera: later scene or camera changes fall back to rendering.
+            self.reference_file = None;
+            self.publish_reference(status);
+            return;
+        }
+        let Some(target) = self.reference_spp else {
+            self.publish_reference(ReferenceStatus::Off);
+            return;
+        };
+        if let Some(folder) = &self.reference_cache
+            && let Some(r) = load_cached(folder, &self.scene, target)
+        {
+            let note = match &r.origin {
+                ReferenceOrigin::Cache(p) => format!("cached in {}", p.display()),
+                _ => String::new(),
+            };
+            self.publish_reference(ReferenceStatus::Ready { reference: Arc::new(r), note });
+            return;
+        }
+        self.job = Some(ReferenceJob {
+            target: target.max(1),
+            cache: self.reference_cache.clone(),
+            film: Film::new(w, h),
+            spp: 0,
+            elapsed: Duration::ZERO,
+        });
+        self.publish_reference(ReferenceStatus::Rendering { spp: 0, target, elapsed: Duration::ZERO });
+    }
+
+    /// One sample per pixel into a scratch film, merged into the reference only if no command arrived meanwhile
+    /// (so a reference pass never delays a new setting by more than a row).
+    fn reference_pass(&mut self, pool: &rayon::ThreadPool) {
+        let Some(job) = &mut self.job else { return };
+        let generation = self.shared.generation.load(Ordering::SeqCst);
+        let current = &self.shared.generation;
+        let cancelled = move || current.load(Ordering::Relaxed) != generation;
+        let mut scratch = Film::new(job.film.width, job.film.height);
+        let start = Instant::now();
+        let renderer = Renderer::new(&self.scene, reference_settings());
+        pool.install(|| renderer.render_pass(&mut scratch, job.spp, 1, &cancelled));
+        if cancelled() {
+            return;
+        }
+        job.elapsed += start.elapsed();
+        job.spp += 1;
+        for (acc, s) in job.film.pixels.iter_mut().zip(&scratch.pixels) {
+            acc.merge(s);
+        }
+        if job.spp < job.target {
+            let status = ReferenceStatus::Rendering { spp: job.spp, target: job.target, elapsed: job.elapsed };
+            self.publish_reference(status);
+            return;
+        }
+        let Some(job) = self.job.take() else { return };
+        let reference = Reference::from_film(&job.film, job.elapsed.as_secs_f64());
+        let note = match &job.cache {
+            Some(folder) => match store_cached(folder, &self.scene, &reference) {
+                Ok(p) => format!("rendered in {:.1} s, cached in {}", job.elapsed.as_secs_f64(), p.display()),
+                Err(e) => format!("rendered in {:.1} s, not cached: {e}", job.elapsed.as_secs_f64()),
+            },
+            None => format!("rendered in {:.1} s", job.elapsed.as_secs_f64()),
+        };
+        self.publish_reference(ReferenceStatus::Ready { reference: Arc::new(reference), note });
+    }
+
+    fn publish_reference(&self, status: ReferenceStatus) {
+        if let Ok(mut slot) = self.latest.reference.lock() {
+            *slot = Some(status);
+        }
+        (self.notify)();
+    }
+
+    /// Publishes a quick look at a new setting: one sample per pixel at half resolution (a quarter of a full
+    /// pass), upsampled. It goes to a separate film: the accumulated image is not touched.
+    fn preview(&mut self, i: usize, pool: &rayon::ThreadPool) {
+        self.lanes[i].previewed = true;
+        let camera = self.scene.camera;
+        if camera.width * camera.height < 128 * 128 {
+            return; // a full pass is quick enough
+        }
+        let small = Camera { width: camera.width.div_ceil(2), height: camera.height.div_ceil(2), ..camera };
+        let lane = &self.lanes[i];
+        let generation = lane.generation;
+        let current = &self.shared.resets[i];
+        let cancelled = move || current.load(Ordering::Relaxed) != generation;
+        let renderer = Renderer::with_camera(&self.scene, lane.settings, &small);
+        let mut film = Film::new(small.width, small.height);
+        let stats = pool.install(|| renderer.render_pass(&mut film, 0, 1, &cancelled));
+        if cancelled() {
+            return;
+        }
+        let means = film.means();
+        let radiance = (0..camera.height)
+            .flat_map(|y| (0..camera.width).map(move |x| (x / 2, y / 2)))
+            .map(|(x, y)| means[(y * small.width + x) as usize])
+            .collect();
+        self.publish(Frame {
+            lane: i,
+            generation,
+            width: camera.width,
+            height: camera.height,
+            radiance,
+            std_error: Vec::new(),
+            relative_variance: Vec::new(),
+            largest_share: Vec::new(),
+            spp: 0,
+            passes: 0,
+            elapsed: Duration::ZERO,
+            stats,
+            settings: lane.settings,
+            scene_name: self.scene.name.clone(),
+            camera,
+            preview: true,
+        });
+    }
+
+    fn publish(&self, frame: Frame) {
+        if let Ok(mut slot) = self.latest.frames[frame.lane].lock() {
+            *slot = Some(Arc::new(frame));
+        }
+        (self.notify)();
+    }
+
+    fn pass(&mut self, i: usize, pool: &rayon::ThreadPool) {
+        let equal_time = self.comparing && self.budget == Budget::EqualTime;
+        let lane = &mut self.lanes[i];
+        let count = match self.target {
+            Some(t) if !equal_time => self.spp_per_pass.min(t.saturating_sub(lane.spp)).max(1),
+            _ => self.spp_per_pass,
+        };
+        let generation = lane.generation;
+        let current = &self.shared.resets[i];
+        let cancelled = move || current.load(Ordering::Relaxed) != generation;
+        let start = Instant::now();
+        let renderer = Renderer::new(&self.scene, lane.settings);
+        let stats = pool.install(|| renderer.render_pass(&mut lane.film, lane.spp, count, &cancelled));
+        if cancelled() {
+            return; // partial: the pending command restarts this film
+        }
+        lane.elapsed += start.elapsed();
+        lane.spp += count;
+        lane.passes += 1;
+        lane.stats += stats;
+        if equal_time && self.time_budget.is_none() && self.target.is_some_and(|t| lane.spp >= t) {
+            self.time_budget = Some(lane.stats.cpu);
+        }
+        let lane = &self.lanes[i];
+        let pixels = &lane.film.pixels;
+        let frame = Frame {
+            lane: i,
+            generation,
+            width: lane.film.width,
+            height: lane.film.height,
+            radiance: lane.film.means(),
+            std_error: pixels.iter().map(|p| p.std_error() as f32).collect(),
+            relative_variance: pixels.iter().map(|p| p.relative_variance() as f32).collect(),
+            largest_share: pixels.iter().map(|p| p.largest_share() as f32).collect(),
+            spp: lane.spp,
+            passes: lane.passes,
+            elapsed: lane.elapsed,
+            stats: lane.stats,
+            settings: lane.settings,
+            scene_name: self.scene.name.clone(),
+            camera: self.scene.camera,
+            preview: false,
+        };
+        self.publish(frame);
+    }
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::Strategy;
+    use crate::scene::load_scene;
+
+    fn wait_for(worker: &Worker, pred: impl Fn(&Frame) -> bool) -> Arc<Frame> {
+        wait_for_lane(worker, A, pred)
+    }
+
+    fn wait_for_lane(worker: &Worker, lane: usize, pred: impl Fn(&Frame) -> bool) -> Arc<Frame> {
+        let start = Instant::now();
+        loop {
+            if let Some(f) = worker.take_lane(lane)
+                && pred(&f)
+            {
+                return f;
+            }
+            assert!(start.elapsed() < Duration::from_secs(60), "no matching frame");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn wait_for_reference(worker: &Worker) -> (Arc<Reference>, String) {
+        let start = Instant::now();
+        loop {
+            match worker.take_reference() {
+                Some(ReferenceStatus::Ready { reference, note }) => return (reference, note),
+                Some(ReferenceStatus::Failed(e)) => panic!("reference failed: {e}"),
+                _ => {}
+            }
+            assert!(start.elapsed() < Duration::from_secs(60), "no reference");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn settings(strategy: Strategy) -> RenderSettings {
+        RenderSettings { strategy, ..RenderSettings::default() }
+    }
+
+    fn small_scene() -> Arc<Scene> {
+        let mut scene = load_scene("cornell-box").expect("bundled");
+        scene.camera.width = 32;
+        scene.camera.height = 32;
+        Arc::new(scene)
+    }
+
+    #[test]
+    fn refines_then_restarts_on_a_new_strategy() {
+        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
+        let f = wait_for(&worker, |f| f.spp >= 3);
+        assert_eq!(f.settings.strategy, Strategy::Emitter);
+        worker.send(Command::SetSettings(RenderSettings { strategy: Strategy::Cosine, ..RenderSettings::default() }));
+        let g = wait_for(&worker, |g| g.settings.strategy == Strategy::Cosine);
+        assert!(g.generation > f.generation);
+        // Restarted: the film holds exactly samples 0..spp of the new strategy, however many passes ran.
+        let mut film = Film::new(32, 32);
+        Renderer::new(&small_scene(), g.settings).render_pass(&mut film, 0, g.spp, &|| false);
+        assert_eq!(g.radiance, film.means(), "accumulation restarted");
+    }
+
+    #[test]
+    fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
+        let scene = small_scene();
+        let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
+        worker.send(Command::SetTargetSpp(Some(5)));
+        worker.send(Command::SetSppPerPass(2));
+        let f = wait_for(&worker, |f| f.spp == 5);
+        std::thread::sleep(Duration::from_millis(50));
+        assert!(worker.take_frame().is_none(), "idle at the target");
+        // The progressive film equals a one-shot render of the same samples.
+        let mut film = Film::new(32, 32);
+        Renderer::new(&scene, RenderSettings::default()).render_pass(&mut film, 0, 5, &|| false);
+        assert_eq!(f.radiance, film.means());
+    }
+
+    #[test]
+    fn equal_samples_with_common_random_numbers_makes_identical_strategies_identical() {
+        let worker = Worker::spawn(small_scene(), settings(Strategy::Brdf), 1, || {});
+        worker.send(Command::SetCompare(Some(settings(Strategy::Brdf))));
+        worker.send(Command::SetTargetSpp(Some(6)));
+        let a = wait_for_lane(&worker, A, |f| f.spp == 6);
+        let b = wait_for_lane(&worker, B, |f| f.spp == 6);
+        assert_eq!(a.radiance, b.radiance, "A − B is zero everywhere");
+        assert_eq!(a.std_error, b.std_error);
+        // A different estimator on the same streams differs, but sees the same camera rays.
+        worker.send(Command::SetCompare(Some(settings(Strategy::Cosine))));
+        let c = wait_for_lane(&worker, B, |f| f.spp == 6 && f.settings.strategy == Strategy::Cosine);
+        assert_ne!(a.radiance, c.radiance);
+        assert!(worker.take_lane(A).is_none() || a.spp == 6, "A kept its film");
+    }
+
+    #[test]
+    fn equal_time_gives_both_lanes_the_same_cpu_time() {
+        // Projected-solid-angle sampling costs about twice as much per sample as cosine sampling.
+        let worker = Worker::spawn(small_scene(), settings(Strategy::Cosine), 1, || {});
+        worker.send(Command::SetCompare(Some(settings(Strategy::ProjectedSolidAngle))));
+        worker.send(Command::SetBudget(Budget::EqualTime));
+        worker.send(Command::SetSppPerPass(4));
+        worker.send(Command::SetTargetSpp(Some(400)));
+        let a = wait_for_lane(&worker, A, |f| f.spp >= 400);
+        let b = wait_for_lane(&worker, B, |f| f.stats.cpu >= a.stats.cpu);
+        std::thread::sleep(Duration::from_millis(100));
+        let b = worker.take_lane(B).unwrap_or(b);
+        let (ta, tb) = (a.stats.cpu.as_secs_f64(), b.stats.cpu.as_secs_f64());
+        assert!((ta - tb).abs() <= 0.1 * ta.max(tb), "CPU time A {ta:.3} s, B {tb:.3} s");
+        assert!(b.spp < a.spp, "the costlier estimator took fewer samples: {} vs {}", b.spp, a.spp);
+        assert!(worker.take_lane(A).is_none(), "A stopped at the time budget");
+    }
+
+    #[test]
+    fn reference_is_rendered_cached_and_reused() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let cache = Some(dir.path().to_path_buf());
+        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
+        worker.send(Command::SetReference { spp: Some(16), cache: cache.clone() });
+        let (rendered, note) = wait_for_reference(&worker);
+        assert_eq!(rendered.spp, 16);
+        assert!(note.contains("cached in"), "{note}");
+        // A strategy change keeps it; a new worker finds it in the cache.
+        worker.send(Command::SetSettings(settings(Strategy::Cosine)));
+        std::thread::sleep(Duration::from_millis(50));
+        assert!(worker.take_reference().is_none(), "still the same reference");
+        drop(worker);
+        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
+        worker.send(Command::SetReference { spp: Some(16), cache });
+        let (cached, note) = wait_for_reference(&worker);
+        assert!(matches!(cached.origin, ReferenceOrigin::Cache(_)), "{note}");
+        assert_eq!(cached.mean, rendered.mean);
+        // The reference is independent of the estimates: it uses its own seed.
+        let f = wait_for(&worker, |f| f.spp >= 16);
+        assert_ne!(f.radiance, cached.mean);
+    }
+
+    #[test]
+    fn a_bad_reference_file_is_reported() {
+        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
+        worker.send(Command::LoadReference(PathBuf::from("/nonexistent/ref.exr")));
+        let start = Instant::now();
+        let message = loop {
+            if let Some(ReferenceStatus::Failed(e)) = worker.take_reference() {
+                break e;
+            }
+            assert!(start.elapsed() < Duration::from_secs(30));
+            std::thread::sleep(Duration::from_millis(2));
+        };
+        assert!(message.contains("/nonexistent/ref.exr"), "{message}");
+        wait_for(&worker, |f| f.spp >= 2);
+    }
+}
