@@ -1,6 +1,7 @@
 #!/bin/sh
 # Runs `illumlab bench` on every bundled scene (default budgets 1..256 spp, reference at 4096 spp) and writes
-# docs/bench/<scene>/{bench.csv,bench.md,convergence.png}. Run on an otherwise idle machine: timings are wall-clock.
+# docs/bench/<scene>/{bench.csv,bench.md,convergence.png,convergence-relative.png}. Run it on an otherwise idle
+# machine: timings are wall-clock.
 set -e
 cd "$(dirname "$0")/.."
 cargo build --release

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs the real viewer under Xvfb (Mesa's software Vulkan), waits for it to refine, and captures the window:
-# screenshots/viewer-<scene>-<strategy>.png for each bundled scene and a few strategies.
+# screenshots/viewer-<scene>-<strategy>.png for each bundled scene and a few strategies, and compare mode
+# (screenshots/viewer-compare-*.png; references are rendered into a temporary cache).
 # Needs: xvfb xauth mesa-vulkan-drivers libvulkan1 libegl1 libgl1-mesa-dri imagemagick (Debian).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,6 +9,7 @@ cargo build --release --quiet
 bin=$PWD/target/release/illumlab
 wait_s=${WAIT:-12}
 runtime=$(mktemp -d); chmod 700 "$runtime"; export XDG_RUNTIME_DIR=$runtime
+export XDG_CACHE_HOME=$runtime/cache
 shoot() { # scene strategy exposure
   local out="screenshots/viewer-$1-$2.png"
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
@@ -23,3 +25,15 @@ shoot cornell-box cosine 1
 shoot veach-mis brdf 0
 shoot veach-mis emitter 0
 shoot near-light emitter -2
+shoot_compare() { # name seconds scene args…
+  local out="screenshots/viewer-compare-$1.png" wait=$2 scene=$3; shift 3
+  xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+    '$bin' view '$scene' $* & pid=\$!
+    sleep $wait
+    import -window root '$out'
+    kill \$pid; wait \$pid 2>/dev/null || true"
+  echo "$out"
+}
+shoot_compare split 40 veach-mis --strategy emitter --compare brdf --target-spp 256 --reference-spp 256 --plot
+shoot_compare errors 15 cornell-box --strategy emitter --compare cosine --view std-error --target-spp 64 --exposure 1
+shoot_compare plot 60 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2

@@ -258,7 +258,7 @@ fn compare_mode_swap_wipe_budgets_and_export() {
         "relative-variance-b.png",
         "abs-error-a.png",
         "fireflies-b.png",
-        "difference-a.png",
+        "difference.png",
         "convergence.png",
         "comparison.json",
     ] {

@@ -198,6 +198,13 @@ impl Viewer {
         }
     }
 
+    fn reference_arc(&self) -> Option<Arc<Reference>> {
+        match &self.reference {
+            ReferenceStatus::Ready { reference, .. } => Some(reference.clone()),
+            _ => None,
+        }
+    }
+
     /// The convergence runs recorded against the current reference.
     pub fn history(&self) -> &[Series] {
         &self.history
@@ -283,16 +290,22 @@ impl Viewer {
     /// The newest frames and reference from the worker, if any; records convergence; refreshes textures lazily.
     fn take_frames(&mut self) {
         if let Some(status) = self.worker.take_reference() {
-            let new_reference = matches!(status, ReferenceStatus::Ready { .. })
-                || !matches!(self.reference, ReferenceStatus::Rendering { .. });
-            if new_reference {
+            // Progress reports of the same render change neither the runs nor the maps.
+            let progress = matches!(
+                (&self.reference, &status),
+                (ReferenceStatus::Rendering { .. }, ReferenceStatus::Rendering { .. })
+            );
+            if !progress {
                 self.history.clear();
+                self.texture_stale = true;
             }
             self.reference = status;
-            self.texture_stale = true;
         }
         for lane in [A, B] {
             let Some(frame) = self.worker.take_lane(lane) else { continue };
+            if lane == B && !self.comparing {
+                continue; // a frame from before compare mode was left
+            }
             if let Some((sent, generation)) = self.restart_sent
                 && frame.generation >= generation
             {
@@ -313,13 +326,17 @@ impl Viewer {
         }
     }
 
-    /// Adds a point to the frame's convergence run (a restarted run starts its series again).
+    /// Adds a point to the frame's convergence run (a restarted run starts its series again). B's frames are
+    /// skipped when B runs A's estimator: with common random numbers they are the same run.
     fn record(&mut self, frame: &Frame) {
-        let Some(reference) = self.reference() else { return };
+        let Some(reference) = self.reference_arc() else { return };
         if frame.preview || frame.spp == 0 || reference.mean.len() != frame.radiance.len() {
             return;
         }
-        let metrics = error_vs_reference(&frame.radiance, reference);
+        if frame.lane == B && series_label(&frame.settings) == series_label(&self.settings) {
+            return;
+        }
+        let metrics = error_vs_reference(&frame.radiance, &reference);
         let point = ConvergencePoint::new(frame.spp, frame.stats.cpu.as_secs_f64(), &metrics);
         let label = series_label(&frame.settings);
         let series = match self.history.iter().position(|s| s.label == label) {
@@ -340,8 +357,8 @@ impl Viewer {
         let frames = [self.frame.clone(), self.frame_b.clone().filter(|_| self.comparing)];
         if self.texture_stale || self.textures[A].is_none() {
             self.texture_stale = false;
-            let reference = self.reference().cloned();
-            let reference = reference.as_ref();
+            let reference = self.reference_arc();
+            let reference = reference.as_deref();
             let values: Vec<Option<Vec<f32>>> = [A, B]
                 .map(|i| {
                     let f = frames[i].as_deref()?;
@@ -350,7 +367,8 @@ impl Viewer {
                 .into();
             let shown: Vec<&[f32]> = values.iter().flatten().map(|v| v.as_slice()).collect();
             self.scale = shared_scale(&shown);
-            self.view_note = frames[A].as_deref().and_then(|f| unavailable(self.view, f, reference, self.comparing));
+            self.view_note =
+                frames[A].as_deref().and_then(|f| unavailable(self.view, f, reference, frames[B].as_deref()));
             if self.view_note.is_none() && self.view != View::Image && self.scale.is_none() {
                 self.view_note = Some("zero everywhere");
             }
@@ -488,11 +506,11 @@ impl Viewer {
             self.message = Some("nothing to compare yet".into());
             return;
         };
-        let reference = self.reference().cloned();
+        let reference = self.reference_arc();
         let comparison = Comparison {
             a: &a,
             b: &b,
-            reference: reference.as_ref(),
+            reference: reference.as_deref(),
             series: &self.history,
             budget: self.budget,
             wipe: self.wipe,

@@ -69,10 +69,8 @@ pub fn viewport_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         painter.text(at, egui::Align2::CENTER_TOP, text, egui::FontId::proportional(14.0), egui::Color32::YELLOW);
     }
     if v.view != View::Image {
-        let bar = egui::Rect::from_min_size(
-            egui::pos2(area.center().x - 200.0, rects[0].max.y.max(rect.max.y) + 8.0),
-            egui::vec2(400.0, 12.0),
-        );
+        let bar =
+            egui::Rect::from_min_size(egui::pos2(area.center().x - 200.0, rect.max.y + 8.0), egui::vec2(400.0, 12.0));
         legend(v, &painter, bar);
     }
 

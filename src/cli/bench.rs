@@ -3,8 +3,8 @@
 use super::{MisArgs, parse_light_selection, parse_size, parse_strategy, pass_size};
 use anyhow::{Context, Result, bail};
 use illumlab::measure::{
-    BenchContext, Reference, machine_description, markdown, reference_settings, run_bench, write_convergence_png,
-    write_csv,
+    BenchContext, Metric, Reference, machine_description, markdown, reference_settings, run_bench,
+    write_convergence_png, write_csv,
 };
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy, check_output_path};
 use illumlab::scene::{LightSelection, Scene, load_scene};
@@ -116,11 +116,23 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     write(&out.join("bench.md"), md.as_bytes())?;
     write_csv(&out.join("bench.csv"), &report).map_err(anyhow::Error::msg)?;
     let title = format!("{} {w}x{h}: RMSE against the reference", scene.name);
-    write_convergence_png(&out.join("convergence.png"), &title, &report.series, report.reference_rmse)?;
+    write_convergence_png(
+        &out.join("convergence.png"),
+        &title,
+        &report.series,
+        report.reference_rmse,
+        Metric::Mse,
+        WALL,
+    )?;
+    let title = format!("{} {w}x{h}: relative RMSE against the reference", scene.name);
+    let floor = reference.noise_rel_mse().sqrt();
+    write_convergence_png(&out.join("convergence-relative.png"), &title, &report.series, floor, Metric::RelMse, WALL)?;
     println!("{md}");
-    println!("wrote {}/bench.csv, bench.md, convergence.png", out.display());
+    println!("wrote {}/bench.csv, bench.md, convergence.png, convergence-relative.png", out.display());
     Ok(())
 }
+
+const WALL: &str = "wall-clock seconds";
 
 /// Renders the reference with [`reference_settings`] in passes of a few samples.
 fn render_reference(scene: &Scene, spp: u32) -> Reference {

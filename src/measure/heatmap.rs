@@ -18,8 +18,11 @@ impl ColorScale {
         if v.is_empty() {
             return None;
         }
-        v.sort_unstable_by(f32::total_cmp);
-        let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+        // Two order statistics by selection, O(n): this runs on the UI thread for every new frame.
+        let mut at = |q: f64| {
+            let k = ((v.len() - 1) as f64 * q).round() as usize;
+            *v.select_nth_unstable_by(k, f32::total_cmp).1
+        };
         let (lo, hi) = (at(0.01), at(0.999));
         // At least a factor 10 so a flat map still reads.
         let hi = hi.max(lo * 10.0);

@@ -2,7 +2,7 @@
 //! log–log, one line per estimator, with a 1/√N slope for orientation and the reference's noise floor.
 //! Text uses egui's embedded Ubuntu font, so no system font is needed.
 
-use super::Series;
+use super::{Metric, Series};
 use crate::render::{OutputError, write_png_rgba};
 use plotters::prelude::*;
 use std::path::Path;
@@ -10,8 +10,16 @@ use std::path::Path;
 const WIDTH: u32 = 1200;
 const HEIGHT: u32 = 480;
 
-/// Draws the plot into RGBA pixels (`WIDTH`×`HEIGHT`); `floor` is the reference's RMSE (0: not drawn).
-pub fn convergence_rgba(title: &str, series: &[Series], floor: f64) -> Result<(u32, u32, Vec<u8>), String> {
+/// Draws the plot into RGBA pixels (`WIDTH`×`HEIGHT`): the square root of `metric` (RMSE, or relative RMSE
+/// `sqrt(relMSE)`); `floor` is the reference's own value of it (0: not drawn); `time_axis` names the seconds
+/// (wall-clock, CPU).
+pub fn convergence_rgba(
+    title: &str,
+    series: &[Series],
+    floor: f64,
+    metric: Metric,
+    time_axis: &str,
+) -> Result<(u32, u32, Vec<u8>), String> {
     register_font();
     let mut rgb = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     {
@@ -19,8 +27,8 @@ pub fn convergence_rgba(title: &str, series: &[Series], floor: f64) -> Result<(u
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(|e| e.to_string())?;
         let (left, right) = root.split_horizontally(WIDTH / 2);
-        panel(&left, series, floor, "samples per pixel", |p| p.spp as f64)?;
-        panel(&right, series, floor, "seconds", |p| p.seconds)?;
+        panel(&left, series, floor, metric, "samples per pixel", |p| p.spp as f64)?;
+        panel(&right, series, floor, metric, time_axis, |p| p.seconds)?;
         root.present().map_err(|e| e.to_string())?;
     }
     let rgba = rgb.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect();
@@ -28,8 +36,16 @@ pub fn convergence_rgba(title: &str, series: &[Series], floor: f64) -> Result<(u
 }
 
 /// Writes the plot as a PNG, atomically.
-pub fn write_convergence_png(path: &Path, title: &str, series: &[Series], floor: f64) -> Result<(), OutputError> {
-    let (w, h, rgba) = convergence_rgba(title, series, floor).map_err(|e| OutputError::Write(path.to_path_buf(), e))?;
+pub fn write_convergence_png(
+    path: &Path,
+    title: &str,
+    series: &[Series],
+    floor: f64,
+    metric: Metric,
+    time_axis: &str,
+) -> Result<(), OutputError> {
+    let (w, h, rgba) = convergence_rgba(title, series, floor, metric, time_axis)
+        .map_err(|e| OutputError::Write(path.to_path_buf(), e))?;
     write_png_rgba(path, w, h, rgba)
 }
 
@@ -37,6 +53,7 @@ fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     series: &[Series],
     floor: f64,
+    metric: Metric,
     x_desc: &str,
     x_of: impl Fn(&super::ConvergencePoint) -> f64,
 ) -> Result<(), String> {
@@ -44,7 +61,7 @@ fn panel<DB: DrawingBackend>(
     let points: Vec<(f64, f64)> = series
         .iter()
         .flat_map(|s| s.points.iter())
-        .map(|p| (x_of(p), p.rmse()))
+        .map(|p| (x_of(p), y_of(metric, p)))
         .filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite())
         .collect();
     let bounds = |v: &mut dyn Iterator<Item = f64>| v.fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
@@ -63,7 +80,10 @@ fn panel<DB: DrawingBackend>(
     chart
         .configure_mesh()
         .x_desc(x_desc)
-        .y_desc("RMSE vs reference")
+        .y_desc(match metric {
+            Metric::Mse => "RMSE vs reference",
+            Metric::RelMse => "relative RMSE vs reference",
+        })
         .x_label_formatter(&|v| short(*v))
         .y_label_formatter(&|v| short(*v))
         .label_style(("sans-serif", 14))
@@ -72,7 +92,7 @@ fn panel<DB: DrawingBackend>(
     for (i, s) in series.iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();
         let line: Vec<(f64, f64)> =
-            s.points.iter().map(|p| (x_of(p), p.rmse())).filter(|(x, y)| *x > 0.0 && *y > 0.0).collect();
+            s.points.iter().map(|p| (x_of(p), y_of(metric, p))).filter(|(x, y)| *x > 0.0 && *y > 0.0).collect();
         chart
             .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
             .map_err(err)?
@@ -108,6 +128,13 @@ fn panel<DB: DrawingBackend>(
     Ok(())
 }
 
+fn y_of(metric: Metric, p: &super::ConvergencePoint) -> f64 {
+    match metric {
+        Metric::Mse => p.mse.sqrt(),
+        Metric::RelMse => p.rel_mse.sqrt(),
+    }
+}
+
 fn geometric_mean(points: &[(f64, f64)]) -> (f64, f64) {
     let n = points.len() as f64;
     let (sx, sy) = points.iter().fold((0.0, 0.0), |(a, b), p| (a + p.0.ln(), b + p.1.ln()));
@@ -140,13 +167,14 @@ mod tests {
             a.push(ConvergencePoint { spp, seconds: n * 0.01, mse: 0.01 / n, rel_mse: 0.1 / n });
             b.push(ConvergencePoint { spp, seconds: n * 0.008, mse: 0.09 / n, rel_mse: 0.9 / n });
         }
-        let (w, h, rgba) = convergence_rgba("test", &[a.clone(), b.clone()], 0.005).expect("drawn");
+        let (w, h, rgba) =
+            convergence_rgba("test", &[a.clone(), b.clone()], 0.005, Metric::Mse, "seconds").expect("drawn");
         assert_eq!(rgba.len(), (w * h * 4) as usize);
         let coloured = rgba.chunks_exact(4).filter(|p| p[0].abs_diff(p[1]) > 60 || p[1].abs_diff(p[2]) > 60).count();
         assert!(coloured > 500, "series lines drawn: {coloured} coloured pixels");
         let dir = tempfile::tempdir().expect("temp dir");
         let path = dir.path().join("plot.png");
-        write_convergence_png(&path, "test", &[a, b], 0.0).expect("written");
+        write_convergence_png(&path, "test", &[a, b], 0.0, Metric::RelMse, "seconds").expect("written");
         assert_eq!(image::image_dimensions(&path).expect("png"), (w, h));
     }
 }

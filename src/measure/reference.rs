@@ -140,17 +140,17 @@ impl Reference {
         Err(ReferenceError::Size { path, found: (self.width, self.height), expected: (width, height) })
     }
 
-    /// Writes the mean to `path` and, when known, the variance of the mean to `<stem>.var.exr`, each atomically.
+    /// Writes, when known, the variance of the mean to `<stem>.var.exr`, then the mean to `path`, each
+    /// atomically: a mean on disk always has its variance beside it.
     pub fn save_exr(&self, path: &Path) -> Result<(), ReferenceError> {
         let write = |values: &[Vec3], to: &Path| {
             crate::render::write_image(&Film::from_means(self.width, self.height, values), to, 0.0)
                 .map_err(|e| ReferenceError::Write(to.to_path_buf(), e.to_string()))
         };
-        write(&self.mean, path)?;
         if let Some(var) = &self.var_of_mean {
             write(var, &variance_path(path))?;
         }
-        Ok(())
+        write(&self.mean, path)
     }
 }
 

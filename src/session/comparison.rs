@@ -5,7 +5,7 @@
 use super::snapshot::{SnapshotError, display_rgba};
 use super::views::{View, shared_scale, view_values};
 use super::worker::{Budget, Frame};
-use crate::measure::{Reference, ReferenceOrigin, Series, error_vs_reference, write_convergence_png};
+use crate::measure::{Metric, Reference, ReferenceOrigin, Series, error_vs_reference, write_convergence_png};
 use crate::render::{Film, write_image, write_png_rgba};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
@@ -36,11 +36,21 @@ pub fn write_comparison(c: &Comparison, folder: &Path) -> Result<PathBuf, Snapsh
         b.settings.strategy.name(),
         a.spp.min(b.spp)
     );
-    let out = (0..)
-        .map(|i| folder.join(if i == 0 { stem.clone() } else { format!("{stem}-{i}") }))
-        .find(|p| !p.exists())
-        .ok_or_else(|| SnapshotError::Folder(folder.to_path_buf(), "no free name".into()))?;
-    std::fs::create_dir_all(&out).map_err(|e| SnapshotError::Folder(out.clone(), e.to_string()))?;
+    std::fs::create_dir_all(folder).map_err(|e| SnapshotError::Folder(folder.to_path_buf(), e.to_string()))?;
+    // `create_dir` fails on an existing folder, so two exports never share one.
+    let mut out = None;
+    for i in 0..1000 {
+        let candidate = folder.join(if i == 0 { stem.clone() } else { format!("{stem}-{i}") });
+        match std::fs::create_dir(&candidate) {
+            Ok(()) => {
+                out = Some(candidate);
+                break;
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(SnapshotError::Folder(candidate, e.to_string())),
+        }
+    }
+    let out = out.ok_or_else(|| SnapshotError::Folder(folder.to_path_buf(), "no free name".into()))?;
     let (w, h) = (a.width, a.height);
 
     let png = |name: &str, rgba: Vec<u8>| write_png_rgba(&out.join(name), w, h, rgba);
@@ -59,14 +69,28 @@ pub fn write_comparison(c: &Comparison, folder: &Path) -> Result<PathBuf, Snapsh
             continue;
         };
         let Some(scale) = shared_scale(&[&va, &vb]) else { continue };
-        png(&format!("{}-a.png", view.slug()), scale.colorize(&va))?;
-        png(&format!("{}-b.png", view.slug()), scale.colorize(&vb))?;
+        if view.needs_comparison() {
+            png(&format!("{}.png", view.slug()), scale.colorize(&va))?; // the same map for both lanes
+        } else {
+            png(&format!("{}-a.png", view.slug()), scale.colorize(&va))?;
+            png(&format!("{}-b.png", view.slug()), scale.colorize(&vb))?;
+        }
         scales.insert(view.slug().into(), json!({ "lo": scale.lo, "hi": scale.hi, "log": true }));
     }
     if c.series.iter().any(|s| !s.points.is_empty()) {
         let floor = c.reference.map_or(0.0, |r| r.noise_mse().sqrt());
         let title = format!("{}: RMSE against the reference", a.scene_name);
-        write_convergence_png(&out.join("convergence.png"), &title, c.series, floor)?;
+        write_convergence_png(&out.join("convergence.png"), &title, c.series, floor, Metric::Mse, "CPU seconds")?;
+        let floor = c.reference.map_or(0.0, |r| r.noise_rel_mse().sqrt());
+        let title = format!("{}: relative RMSE against the reference", a.scene_name);
+        write_convergence_png(
+            &out.join("convergence-relative.png"),
+            &title,
+            c.series,
+            floor,
+            Metric::RelMse,
+            "CPU seconds",
+        )?;
     }
 
     let sidecar = json!({

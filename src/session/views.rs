@@ -95,15 +95,23 @@ pub fn view_values(
     }
 }
 
-/// Why `view` cannot be shown yet, if it cannot.
-pub fn unavailable(view: View, frame: &Frame, reference: Option<&Reference>, comparing: bool) -> Option<&'static str> {
+/// Why `view` cannot be shown yet for `frame`, if it cannot; `other` is the other lane's frame in compare mode.
+pub fn unavailable(
+    view: View,
+    frame: &Frame,
+    reference: Option<&Reference>,
+    other: Option<&Frame>,
+) -> Option<&'static str> {
     match view {
         _ if frame.preview && view != View::Image => Some("after the first full pass"),
         View::AbsError if reference.is_none() => Some("no reference yet: compute or load one"),
         View::AbsError if reference.is_some_and(|r| r.mean.len() != frame.radiance.len()) => {
             Some("the reference has another size")
         }
-        View::Difference if !comparing => Some("only in compare mode"),
+        View::Difference if other.is_none() => Some("only in compare mode, once B has a frame"),
+        View::Difference if other.is_some_and(|o| o.preview || o.radiance.len() != frame.radiance.len()) => {
+            Some("after B's first full pass")
+        }
         _ => None,
     }
 }
