@@ -25,15 +25,18 @@ shoot cornell-box cosine 1
 shoot veach-mis brdf 0
 shoot veach-mis emitter 0
 shoot near-light emitter -2
-shoot_compare() { # name seconds scene args…
-  local out="screenshots/viewer-compare-$1.png" wait=$2 scene=$3; shift 3
+shoot_compare() { # name warm-up-seconds seconds scene args…
+  # The first run renders the reference into the cache, so the second records convergence from 1 spp.
+  local out="screenshots/viewer-compare-$1.png" warm=$2 wait=$3 scene=$4; shift 4
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+    '$bin' view '$scene' $* & pid=\$!
+    sleep $warm; kill \$pid; wait \$pid 2>/dev/null || true
     '$bin' view '$scene' $* & pid=\$!
     sleep $wait
     import -window root '$out'
     kill \$pid; wait \$pid 2>/dev/null || true"
   echo "$out"
 }
-shoot_compare split 40 veach-mis --strategy emitter --compare brdf --target-spp 256 --reference-spp 256 --plot
-shoot_compare errors 15 cornell-box --strategy emitter --compare cosine --view std-error --target-spp 64 --exposure 1
-shoot_compare plot 60 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2
+shoot_compare split 45 25 veach-mis --strategy emitter --compare brdf --target-spp 256 --reference-spp 256 --plot
+shoot_compare errors 1 15 cornell-box --strategy emitter --compare cosine --view std-error --target-spp 64 --exposure 1
+shoot_compare plot 50 30 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2

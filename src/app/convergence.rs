@@ -47,6 +47,9 @@ pub fn convergence_window(v: &mut Viewer, ui: &mut egui::Ui) {
             plot(&mut columns[1], "rmse-seconds", ("CPU seconds", y_label), &v.history, floor, (|p| p.seconds, y));
         });
         efficiency_table(ui, &v.history);
+        if v.history.iter().any(|s| s.points.first().is_some_and(|p| p.spp > 1)) {
+            ui.small("Runs that began before the reference was ready start late: press R to record them from 1 spp.");
+        }
         if ui.button("Clear runs").clicked() {
             v.history.clear();
         }
@@ -63,43 +66,61 @@ fn plot(ui: &mut egui::Ui, id: &str, labels: (&str, &str), series: &[Series], fl
         let v = 10f64.powf(m.value);
         if (0.01..10000.0).contains(&v) { format!("{}", (v * 1000.0).round() / 1000.0) } else { format!("{v:.0e}") }
     };
-    Plot::new(id)
+    let lines: Vec<(String, Vec<[f64; 2]>)> = series
+        .iter()
+        .map(|s| {
+            let pts = s
+                .points
+                .iter()
+                .filter(|p| x_of(p) > 0.0 && y_of(p) > 0.0)
+                .map(|p| [log(x_of(p)), log(y_of(p))])
+                .collect();
+            (s.label.clone(), pts)
+        })
+        .collect();
+    let all: Vec<[f64; 2]> = lines.iter().flat_map(|l| l.1.iter().copied()).collect();
+    let range = |k: usize| {
+        let lo = all.iter().map(|p| p[k]).fold(f64::INFINITY, f64::min);
+        let hi = all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
+        (lo, hi)
+    };
+    let ((x0, x1), (y0, y1)) = (range(0), range(1));
+    let y0 = if floor > 0.0 { y0.min(log(floor)) } else { y0 };
+    // Fixed bounds around the data (a tenth of a decade of margin): the plot follows new points and cannot be
+    // dragged away from them.
+    let mut plot = Plot::new(id)
         .height(300.0)
         .legend(Legend::default())
         .x_axis_label(labels.0)
         .y_axis_label(labels.1)
         .x_axis_formatter(label)
         .y_axis_formatter(label)
-        .show(ui, |plot| {
-            let mut all = Vec::new();
-            for s in series {
-                let pts: Vec<[f64; 2]> = s
-                    .points
-                    .iter()
-                    .filter(|p| x_of(p) > 0.0 && y_of(p) > 0.0)
-                    .map(|p| [log(x_of(p)), log(y_of(p))])
-                    .collect();
-                all.extend(pts.iter().copied());
-                plot.line(Line::new(s.label.clone(), PlotPoints::from(pts.clone())).width(2.0));
-                plot.points(Points::new(s.label.clone(), PlotPoints::from(pts)).radius(2.5));
-            }
-            // A −½ slope through the middle of the data.
-            if let (Some(x0), Some(x1)) =
-                (all.iter().map(|p| p[0]).min_by(f64::total_cmp), all.iter().map(|p| p[0]).max_by(f64::total_cmp))
-            {
-                let n = all.len() as f64;
-                let (mx, my) = (all.iter().map(|p| p[0]).sum::<f64>() / n, all.iter().map(|p| p[1]).sum::<f64>() / n);
-                let guide: Vec<[f64; 2]> = [x0, x1].iter().map(|&x| [x, my - 0.5 * (x - mx)]).collect();
-                plot.line(
-                    Line::new("slope -1/2", PlotPoints::from(guide))
-                        .style(LineStyle::dashed_loose())
-                        .color(egui::Color32::GRAY),
-                );
-            }
-            if floor > 0.0 {
-                plot.hline(HLine::new("reference noise", log(floor)).style(LineStyle::dotted_dense()));
-            }
-        });
+        .allow_drag(false)
+        .allow_zoom(false)
+        .allow_scroll(false);
+    if x0.is_finite() && y0.is_finite() {
+        plot = plot.include_x(x0 - 0.1).include_x(x1 + 0.1).include_y(y0 - 0.1).include_y(y1 + 0.1);
+    }
+    plot.show(ui, |plot| {
+        for (label, pts) in lines {
+            plot.line(Line::new(label.clone(), PlotPoints::from(pts.clone())).width(2.0));
+            plot.points(Points::new(label, PlotPoints::from(pts)).radius(2.5));
+        }
+        // A −½ slope through the middle of the data.
+        if x0.is_finite() && x1 > x0 {
+            let n = all.len() as f64;
+            let (mx, my) = (all.iter().map(|p| p[0]).sum::<f64>() / n, all.iter().map(|p| p[1]).sum::<f64>() / n);
+            let guide: Vec<[f64; 2]> = [x0, x1].iter().map(|&x| [x, my - 0.5 * (x - mx)]).collect();
+            plot.line(
+                Line::new("slope -1/2", PlotPoints::from(guide))
+                    .style(LineStyle::dashed_loose())
+                    .color(egui::Color32::GRAY),
+            );
+        }
+        if floor > 0.0 {
+            plot.hline(HLine::new("reference noise", log(floor)).style(LineStyle::dotted_dense()));
+        }
+    });
 }
 
 /// Per run at its largest budget: spp, CPU seconds, RMSE, relMSE, and both efficiencies; the best in each
