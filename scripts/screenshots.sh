@@ -24,6 +24,7 @@ shoot cornell-box emitter 1
 shoot cornell-box cosine 1
 shoot veach-mis brdf 0
 shoot veach-mis emitter 0
+shoot veach-mis mis 0
 shoot near-light emitter -2
 shoot_compare() { # name warm-up-seconds seconds scene args…
   # The first run renders the reference into the cache, so the second records convergence from 1 spp.

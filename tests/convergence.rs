@@ -64,6 +64,7 @@ fn rmse_falls_as_one_over_root_n() {
     let pooled = pooled_mse(&s, &r, &strategies, &[4, 16, 64], 0..16);
     for (strategy, points) in strategies.iter().zip(&pooled) {
         let k = slope(points);
+        println!("{}: RMSE slope {k:.3}", strategy.name());
         assert!((k + 0.5).abs() <= 0.12, "{}: RMSE slope {k:.3} (points {points:?})", strategy.name());
         // And the estimator is well above the reference's noise at every budget, so the slope is its own.
         assert!(points.iter().all(|p| p.1 > 2.0 * r.noise_mse()), "{points:?} vs floor {}", r.noise_mse());

@@ -1,13 +1,13 @@
 //! `illumlab bench`: every strategy at several budgets against a reference, written as CSV, markdown and a plot.
 
-use super::{MisArgs, parse_light_selection, parse_size, parse_strategy, pass_size};
+use super::{MisArgs, load_sized, parse_light_selection, parse_size, parse_strategy, pass_size, thread_pool};
 use anyhow::{Context, Result, bail};
 use illumlab::measure::{
     BenchContext, Metric, Reference, machine_description, markdown, reference_settings, run_bench,
     write_convergence_png, write_csv,
 };
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy, check_output_path};
-use illumlab::scene::{LightSelection, Scene, load_scene};
+use illumlab::scene::{LightSelection, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,21 +49,11 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     budgets.sort_unstable();
     budgets.dedup();
     let strategies = if args.strategies.is_empty() { Strategy::ALL.to_vec() } else { args.strategies.clone() };
-    let mut scene = load_scene(&args.scene)?;
-    if let Some((w, h)) = args.size {
-        scene.camera.width = w;
-        scene.camera.height = h;
-    }
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", scene.name);
-    }
+    let scene = load_sized(&args.scene, args.size)?;
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("bench-{}", scene.name)));
     std::fs::create_dir_all(&out).with_context(|| format!("output folder {}", out.display()))?;
     check_output_path(&out.join("convergence.png"))?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .context("cannot start the worker threads")?;
+    let pool = thread_pool(args.threads)?;
     let (w, h) = (scene.camera.width, scene.camera.height);
 
     let (reference, reference_line) = match &args.reference {

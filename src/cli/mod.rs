@@ -8,7 +8,7 @@ use illumlab::render::{
     Film, Heuristic, LightTechnique, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
     write_image,
 };
-use illumlab::scene::{LightSelection, load_scene};
+use illumlab::scene::{LightSelection, Scene, load_scene};
 use illumlab::session::views::View;
 use illumlab::session::worker::Budget;
 use std::path::PathBuf;
@@ -227,18 +227,8 @@ fn render(args: RenderArgs) -> Result<()> {
         bail!("--exposure must be a finite number of stops");
     }
     check_output_path(&args.output)?;
-    let mut scene = load_scene(&args.scene)?;
-    if let Some((w, h)) = args.size {
-        scene.camera.width = w;
-        scene.camera.height = h;
-    }
-    for w in &scene.warnings {
-        eprintln!("warning: {}: {w}", scene.name);
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .context("cannot start the worker threads")?;
+    let scene = load_sized(&args.scene, args.size)?;
+    let pool = thread_pool(args.threads)?;
     let settings = RenderSettings {
         strategy: args.strategy,
         light_selection: args.light_selection,
@@ -284,6 +274,27 @@ fn render(args: RenderArgs) -> Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// Loads a scene (file or bundled), overrides the camera's size if asked, and prints its warnings.
+pub(crate) fn load_sized(scene: &str, size: Option<(u32, u32)>) -> Result<Scene> {
+    let mut scene = load_scene(scene)?;
+    if let Some((w, h)) = size {
+        scene.camera.width = w;
+        scene.camera.height = h;
+    }
+    for w in &scene.warnings {
+        eprintln!("warning: {}: {w}", scene.name);
+    }
+    Ok(scene)
+}
+
+/// The pool that renders: `threads` threads, or one per core.
+pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0) as usize)
+        .build()
+        .context("cannot start the worker threads")
 }
 
 /// Samples per pixel per pass: about 2 M samples, so a pass takes some tens of milliseconds.

@@ -755,6 +755,7 @@ mod tests {
         std::thread::sleep(Duration::from_millis(100));
         let b = worker.take_lane(B).unwrap_or(b);
         let (ta, tb) = (a.stats.cpu.as_secs_f64(), b.stats.cpu.as_secs_f64());
+        println!("equal time: A {} spp in {ta:.3} s CPU, B {} spp in {tb:.3} s CPU", a.spp, b.spp);
         assert!((ta - tb).abs() <= 0.1 * ta.max(tb), "CPU time A {ta:.3} s, B {tb:.3} s");
         assert!(b.spp < a.spp, "the costlier estimator took fewer samples: {} vs {}", b.spp, a.spp);
         assert!(worker.take_lane(A).is_none(), "A stopped at the time budget");
