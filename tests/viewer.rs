@@ -15,7 +15,9 @@ fn viewer() -> Viewer {
     let mut scene = load_scene("cornell-box").expect("bundled scene");
     scene.camera.width = 48;
     scene.camera.height = 48;
-    Viewer::with_scene(Arc::new(scene))
+    let mut v = Viewer::with_scene(Arc::new(scene));
+    v.set_reference_cache(None); // tests never write to the user's cache
+    v
 }
 
 fn harness(v: Viewer) -> Harness<'static, Viewer> {
