@@ -1,6 +1,7 @@
 //! The interactive viewer: a thin egui/eframe shell over [`crate::session`]. Only this module knows egui.
 
 mod compare;
+mod compare_mode;
 mod controls;
 mod convergence;
 mod loader;

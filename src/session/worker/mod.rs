@@ -12,10 +12,15 @@
 //! same time within one pass and each shows its own spp. With a target spp, equal time stops each lane at the CPU
 //! time the first one needed to reach the target.
 
-use crate::measure::{Reference, ReferenceOrigin, load_cached, reference_settings, store_cached};
+mod lane;
+mod reference_job;
+
+use crate::measure::Reference;
 use crate::render::{Film, PassStats, RenderSettings, Renderer};
 use crate::scene::{Camera, Material, Scene};
 use glam::Vec3;
+use lane::Lane;
+use reference_job::ReferenceJob;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -229,60 +234,6 @@ impl Drop for Worker {
     }
 }
 
-/// One image being refined.
-struct Lane {
-    settings: RenderSettings,
-    film: Film,
-    spp: u32,
-    passes: u32,
-    stats: PassStats,
-    elapsed: Duration,
-    /// The generation this film belongs to.
-    generation: u64,
-    /// Whether the preview of this generation was published.
-    previewed: bool,
-}
-
-impl Lane {
-    fn new(settings: RenderSettings, camera: &Camera) -> Self {
-        Self {
-            settings,
-            film: Film::new(camera.width, camera.height),
-            spp: 0,
-            passes: 0,
-            stats: PassStats::default(),
-            elapsed: Duration::ZERO,
-            generation: 0,
-            previewed: false,
-        }
-    }
-
-    fn reset(&mut self, camera: &Camera, generation: u64) {
-        if (self.film.width, self.film.height) == (camera.width, camera.height) {
-            self.film.clear();
-        } else {
-            self.film = Film::new(camera.width, camera.height);
-        }
-        self.spp = 0;
-        self.passes = 0;
-        self.stats = PassStats::default();
-        self.elapsed = Duration::ZERO;
-        self.generation = generation;
-        self.previewed = false;
-    }
-}
-
-/// The reference being rendered.
-struct ReferenceJob {
-    target: u32,
-    cache: Option<PathBuf>,
-    film: Film,
-    /// One pass's samples, merged into `film` when the pass completes.
-    scratch: Film,
-    spp: u32,
-    elapsed: Duration,
-}
-
 /// Everything the worker thread owns.
 struct State {
     scene: Arc<Scene>,
@@ -471,89 +422,6 @@ impl State {
         }
     }
 
-    /// Sets up the reference for the current scene: from a file, from the cache, or a render job.
-    fn start_reference(&mut self) {
-        self.job = None;
-        let (w, h) = (self.scene.camera.width, self.scene.camera.height);
-        if let Some(path) = &self.reference_file {
-            let status = match Reference::load_exr(path).and_then(|r| r.check_size(w, h).map(|()| r)) {
-                Ok(r) => ReferenceStatus::Ready { reference: Arc::new(r), note: format!("from {}", path.display()) },
-                Err(e) => ReferenceStatus::Failed(e.to_string()),
-            };
-            // A file matches one camera: later scene or camera changes fall back to rendering.
-            self.reference_file = None;
-            self.publish_reference(status);
-            return;
-        }
-        let Some(target) = self.reference_spp else {
-            self.publish_reference(ReferenceStatus::Off);
-            return;
-        };
-        if let Some(folder) = &self.reference_cache
-            && let Some(r) = load_cached(folder, &self.scene, target)
-        {
-            let note = match &r.origin {
-                ReferenceOrigin::Cache(p) => format!("cached in {}", p.display()),
-                _ => String::new(),
-            };
-            self.publish_reference(ReferenceStatus::Ready { reference: Arc::new(r), note });
-            return;
-        }
-        let target = target.max(1);
-        self.job = Some(ReferenceJob {
-            target,
-            cache: self.reference_cache.clone(),
-            film: Film::new(w, h),
-            scratch: Film::new(w, h),
-            spp: 0,
-            elapsed: Duration::ZERO,
-        });
-        self.publish_reference(ReferenceStatus::Rendering { spp: 0, target, elapsed: Duration::ZERO });
-    }
-
-    /// One sample per pixel into a scratch film, merged into the reference only if no command arrived meanwhile
-    /// (so a reference pass never delays a new setting by more than a row).
-    fn reference_pass(&mut self, pool: &rayon::ThreadPool) {
-        let Some(job) = &mut self.job else { return };
-        let generation = self.shared.generation.load(Ordering::SeqCst);
-        let current = &self.shared.generation;
-        let cancelled = move || current.load(Ordering::Relaxed) != generation;
-        job.scratch.clear();
-        let start = Instant::now();
-        let renderer = Renderer::new(&self.scene, reference_settings());
-        pool.install(|| renderer.render_pass(&mut job.scratch, job.spp, 1, &cancelled));
-        if cancelled() {
-            return;
-        }
-        job.elapsed += start.elapsed();
-        job.spp += 1;
-        for (acc, s) in job.film.pixels.iter_mut().zip(&job.scratch.pixels) {
-            acc.merge(s);
-        }
-        if job.spp < job.target {
-            let status = ReferenceStatus::Rendering { spp: job.spp, target: job.target, elapsed: job.elapsed };
-            self.publish_reference(status);
-            return;
-        }
-        let Some(job) = self.job.take() else { return };
-        let reference = Reference::from_film(&job.film, job.elapsed.as_secs_f64());
-        let note = match &job.cache {
-            Some(folder) => match store_cached(folder, &self.scene, &reference) {
-                Ok(p) => format!("rendered in {:.1} s, cached in {}", job.elapsed.as_secs_f64(), p.display()),
-                Err(e) => format!("rendered in {:.1} s, not cached: {e}", job.elapsed.as_secs_f64()),
-            },
-            None => format!("rendered in {:.1} s", job.elapsed.as_secs_f64()),
-        };
-        self.publish_reference(ReferenceStatus::Ready { reference: Arc::new(reference), note });
-    }
-
-    fn publish_reference(&self, status: ReferenceStatus) {
-        if let Ok(mut slot) = self.latest.reference.lock() {
-            *slot = Some(status);
-        }
-        (self.notify)();
-    }
-
     /// Publishes a quick look at a new setting: one sample per pixel at half resolution (a quarter of a full
     /// pass), upsampled. It goes to a separate film: the accumulated image is not touched.
     fn preview(&mut self, i: usize, pool: &rayon::ThreadPool) {
@@ -652,152 +520,4 @@ impl State {
     }
 }
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::render::Strategy;
-    use crate::scene::load_scene;
-
-    fn wait_for(worker: &Worker, pred: impl Fn(&Frame) -> bool) -> Arc<Frame> {
-        wait_for_lane(worker, A, pred)
-    }
-
-    fn wait_for_lane(worker: &Worker, lane: usize, pred: impl Fn(&Frame) -> bool) -> Arc<Frame> {
-        let start = Instant::now();
-        loop {
-            if let Some(f) = worker.take_lane(lane)
-                && pred(&f)
-            {
-                return f;
-            }
-            assert!(start.elapsed() < Duration::from_secs(60), "no matching frame");
-            std::thread::sleep(Duration::from_millis(2));
-        }
-    }
-
-    fn wait_for_reference(worker: &Worker) -> (Arc<Reference>, String) {
-        let start = Instant::now();
-        loop {
-            match worker.take_reference() {
-                Some(ReferenceStatus::Ready { reference, note }) => return (reference, note),
-                Some(ReferenceStatus::Failed(e)) => panic!("reference failed: {e}"),
-                _ => {}
-            }
-            assert!(start.elapsed() < Duration::from_secs(60), "no reference");
-            std::thread::sleep(Duration::from_millis(2));
-        }
-    }
-
-    fn settings(strategy: Strategy) -> RenderSettings {
-        RenderSettings { strategy, ..RenderSettings::default() }
-    }
-
-    fn small_scene() -> Arc<Scene> {
-        let mut scene = load_scene("cornell-box").expect("bundled");
-        scene.camera.width = 32;
-        scene.camera.height = 32;
-        Arc::new(scene)
-    }
-
-    #[test]
-    fn refines_then_restarts_on_a_new_strategy() {
-        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
-        let f = wait_for(&worker, |f| f.spp >= 3);
-        assert_eq!(f.settings.strategy, Strategy::Emitter);
-        worker.send(Command::SetSettings(RenderSettings { strategy: Strategy::Cosine, ..RenderSettings::default() }));
-        let g = wait_for(&worker, |g| g.settings.strategy == Strategy::Cosine);
-        assert!(g.generation > f.generation);
-        // Restarted: the film holds exactly samples 0..spp of the new strategy, however many passes ran.
-        let mut film = Film::new(32, 32);
-        Renderer::new(&small_scene(), g.settings).render_pass(&mut film, 0, g.spp, &|| false);
-        assert_eq!(g.radiance, film.means(), "accumulation restarted");
-    }
-
-    #[test]
-    fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
-        let scene = small_scene();
-        let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
-        worker.send(Command::SetTargetSpp(Some(5)));
-        worker.send(Command::SetSppPerPass(2));
-        let f = wait_for(&worker, |f| f.spp == 5);
-        std::thread::sleep(Duration::from_millis(50));
-        assert!(worker.take_frame().is_none(), "idle at the target");
-        // The progressive film equals a one-shot render of the same samples.
-        let mut film = Film::new(32, 32);
-        Renderer::new(&scene, RenderSettings::default()).render_pass(&mut film, 0, 5, &|| false);
-        assert_eq!(f.radiance, film.means());
-    }
-
-    #[test]
-    fn equal_samples_with_common_random_numbers_makes_identical_strategies_identical() {
-        let worker = Worker::spawn(small_scene(), settings(Strategy::Brdf), 1, || {});
-        worker.send(Command::SetCompare(Some(settings(Strategy::Brdf))));
-        worker.send(Command::SetTargetSpp(Some(6)));
-        let a = wait_for_lane(&worker, A, |f| f.spp == 6);
-        let b = wait_for_lane(&worker, B, |f| f.spp == 6);
-        assert_eq!(a.radiance, b.radiance, "A − B is zero everywhere");
-        assert_eq!(a.std_error, b.std_error);
-        // A different estimator on the same streams differs, but sees the same camera rays.
-        worker.send(Command::SetCompare(Some(settings(Strategy::Cosine))));
-        let c = wait_for_lane(&worker, B, |f| f.spp == 6 && f.settings.strategy == Strategy::Cosine);
-        assert_ne!(a.radiance, c.radiance);
-    }
-
-    #[test]
-    fn equal_time_gives_both_lanes_the_same_cpu_time() {
-        // Projected-solid-angle sampling costs about twice as much per sample as cosine sampling.
-        let worker = Worker::spawn(small_scene(), settings(Strategy::Cosine), 1, || {});
-        worker.send(Command::SetCompare(Some(settings(Strategy::ProjectedSolidAngle))));
-        worker.send(Command::SetBudget(Budget::EqualTime));
-        worker.send(Command::SetSppPerPass(4));
-        worker.send(Command::SetTargetSpp(Some(400)));
-        let a = wait_for_lane(&worker, A, |f| f.spp >= 400);
-        let b = wait_for_lane(&worker, B, |f| f.stats.cpu >= a.stats.cpu);
-        std::thread::sleep(Duration::from_millis(100));
-        let b = worker.take_lane(B).unwrap_or(b);
-        let (ta, tb) = (a.stats.cpu.as_secs_f64(), b.stats.cpu.as_secs_f64());
-        println!("equal time: A {} spp in {ta:.3} s CPU, B {} spp in {tb:.3} s CPU", a.spp, b.spp);
-        assert!((ta - tb).abs() <= 0.1 * ta.max(tb), "CPU time A {ta:.3} s, B {tb:.3} s");
-        assert!(b.spp < a.spp, "the costlier estimator took fewer samples: {} vs {}", b.spp, a.spp);
-        assert!(worker.take_lane(A).is_none(), "A stopped at the time budget");
-    }
-
-    #[test]
-    fn reference_is_rendered_cached_and_reused() {
-        let dir = tempfile::tempdir().expect("temp dir");
-        let cache = Some(dir.path().to_path_buf());
-        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
-        worker.send(Command::SetReference { spp: Some(16), cache: cache.clone() });
-        let (rendered, note) = wait_for_reference(&worker);
-        assert_eq!(rendered.spp, 16);
-        assert!(note.contains("cached in"), "{note}");
-        // A strategy change keeps it; a new worker finds it in the cache.
-        worker.send(Command::SetSettings(settings(Strategy::Cosine)));
-        std::thread::sleep(Duration::from_millis(50));
-        assert!(worker.take_reference().is_none(), "still the same reference");
-        drop(worker);
-        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
-        worker.send(Command::SetReference { spp: Some(16), cache });
-        let (cached, note) = wait_for_reference(&worker);
-        assert!(matches!(cached.origin, ReferenceOrigin::Cache(_)), "{note}");
-        assert_eq!(cached.mean, rendered.mean);
-        // The reference is independent of the estimates: it uses its own seed.
-        let f = wait_for(&worker, |f| f.spp >= 16);
-        assert_ne!(f.radiance, cached.mean);
-    }
-
-    #[test]
-    fn a_bad_reference_file_is_reported() {
-        let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
-        worker.send(Command::LoadReference(PathBuf::from("/nonexistent/ref.exr")));
-        let start = Instant::now();
-        let message = loop {
-            if let Some(ReferenceStatus::Failed(e)) = worker.take_reference() {
-                break e;
-            }
-            assert!(start.elapsed() < Duration::from_secs(30));
-            std::thread::sleep(Duration::from_millis(2));
-        };
-        assert!(message.contains("/nonexistent/ref.exr"), "{message}");
-        wait_for(&worker, |f| f.spp >= 2);
-    }
-}
+mod tests;
