@@ -241,6 +241,15 @@ fn compare_mode_swap_wipe_budgets_and_export() {
     step_until(&mut h, "the reference and a recorded run", |v| {
         v.reference().is_some() && v.history().iter().any(|s| s.points.len() >= 2)
     });
+    // The convergence window: its plots, the efficiency table and the winner (kittest also fails on any glyph the
+    // fonts cannot draw).
+    h.key_press(egui::Key::P);
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("1/(relMSE·s)").is_some(), "the efficiency table is shown");
+    assert!(h.query_all_by_label_contains("best").count() >= 1, "a winner is highlighted");
+    h.get_by_role_and_label(Role::RadioButton, "RMSE").click();
+    h.step();
     h.get_by_label("Export comparison").click();
     h.step();
     let folder = std::fs::read_dir(dir.path().join("shots"))
