@@ -1,6 +1,6 @@
 //! The measurement end to end: RMSE against a rendered reference falls as 1/√N for every estimator.
 
-use illumlab::measure::{Reference, reference_settings, run_bench};
+use illumlab::measure::{ConvergencePoint, Reference, Series, reference_settings, run_bench};
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
 use illumlab::scene::{Scene, load_scene};
 
@@ -17,13 +17,13 @@ fn reference(scene: &Scene, spp: u32) -> Reference {
     Reference::from_film(&film, 0.0)
 }
 
-/// Least-squares slope of ln √(MSE − reference noise) against ln N.
+/// The log–log slope of √(excess MSE) against N, fitted by the same code as the reports use.
 fn slope(points: &[(u32, f64)]) -> f64 {
-    let pts: Vec<(f64, f64)> = points.iter().map(|&(n, mse)| ((n as f64).ln(), 0.5 * mse.ln())).collect();
-    let k = pts.len() as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / k, pts.iter().map(|p| p.1).sum::<f64>() / k);
-    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-    pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / sxx
+    let mut series = Series::new("pooled");
+    for &(spp, mse) in points {
+        series.push(ConvergencePoint { spp, seconds: 0.0, mse, rel_mse: 0.0 });
+    }
+    series.slope().expect("three points")
 }
 
 /// Per budget, the mean over `seeds` of the excess MSE (reference noise subtracted) of each strategy.

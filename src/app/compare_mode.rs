@@ -21,11 +21,6 @@ impl Viewer {
         self.comparing
     }
 
-    /// The settings of lanes A and B.
-    pub fn lane_settings(&self) -> (RenderSettings, RenderSettings) {
-        (self.settings, self.settings_b)
-    }
-
     pub fn budget(&self) -> Budget {
         self.budget
     }
