@@ -30,16 +30,9 @@ impl Viewer {
     }
 
     /// The reference, once ready.
-    pub fn reference(&self) -> Option<&Reference> {
+    pub fn reference(&self) -> Option<&Arc<Reference>> {
         match &self.reference {
             ReferenceStatus::Ready { reference, .. } => Some(reference),
-            _ => None,
-        }
-    }
-
-    pub(super) fn reference_arc(&self) -> Option<Arc<Reference>> {
-        match &self.reference {
-            ReferenceStatus::Ready { reference, .. } => Some(reference.clone()),
             _ => None,
         }
     }
@@ -76,7 +69,7 @@ impl Viewer {
     /// Adds a point to the frame's convergence run (a restarted run starts its series again). B's frames are
     /// skipped when B runs A's estimator: with common random numbers they are the same run.
     pub(super) fn record(&mut self, frame: &Frame) {
-        let Some(reference) = self.reference_arc() else { return };
+        let Some(reference) = self.reference().cloned() else { return };
         if frame.preview || frame.spp == 0 || reference.mean.len() != frame.radiance.len() {
             return;
         }
@@ -181,7 +174,7 @@ impl Viewer {
             self.message = Some("nothing to compare yet".into());
             return;
         };
-        let reference = self.reference_arc();
+        let reference = self.reference().cloned();
         let comparison = Comparison {
             a: &a,
             b: &b,

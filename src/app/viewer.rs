@@ -264,7 +264,7 @@ impl Viewer {
         let frames = [self.frame.clone(), self.frame_b.clone().filter(|_| self.comparing)];
         if self.texture_stale || self.textures[A].is_none() {
             self.texture_stale = false;
-            let reference = self.reference_arc();
+            let reference = self.reference().cloned();
             let reference = reference.as_deref();
             let values: Vec<Option<Vec<f32>>> = [A, B]
                 .map(|i| {
