@@ -297,9 +297,10 @@ pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
         .context("cannot start the worker threads")
 }
 
-/// Samples per pixel per pass: about 2 M samples, so a pass takes some tens of milliseconds.
+/// Samples per pixel per pass: about 8 M samples, so a pass takes a few tenths of a second and the cost of
+/// gathering each pixel's camera-ray candidates (once per pass) is spread over many samples.
 pub(crate) fn pass_size(spp: u32, pixels: usize) -> u32 {
-    ((2_000_000 / pixels.max(1)) as u32).clamp(1, spp)
+    ((8_000_000 / pixels.max(1)) as u32).clamp(1, spp)
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ mod rng;
 pub use frame::Frame;
 pub use offset::offset_ray_origin;
 pub use polygon::lambert_polygon_irradiance;
-pub use rng::{ONE_MINUS_EPSILON, SampleRng};
+pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng};
 
 /// Reflects `w` about the unit normal `n`: ω_r = 2 (n·ω) n − ω (the lecture's mirror direction).
 #[inline]

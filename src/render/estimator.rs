@@ -45,7 +45,7 @@ fn integrand(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, rays: &mut u
             *rays += 1;
             let origin = offset_ray_origin(sp.p, sp.n);
             let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY)?;
-            (scene.emitted(hit.triangle, -s.wi), (hit.triangle, origin + s.wi * hit.t))
+            (scene.emitted(hit.triangle, -s.wi), (hit.triangle, scene.hit_point(&hit)))
         }
         Target::Emitter { triangle, point } => {
             let le = scene.emitted(triangle, -s.wi);
@@ -97,10 +97,6 @@ pub fn visible(scene: &Scene, p: Vec3, n: Vec3, x: Vec3, n_x: Vec3, rays: &mut u
     *rays += 1;
     let from = offset_ray_origin(p, n);
     let to = offset_ray_origin(x, n_x);
-    let d = to - from;
-    let dist = d.length();
-    if !(dist > 0.0) {
-        return true;
-    }
-    !scene.accel().occluded(from, d / dist, dist * (1.0 - 1e-6))
+    // The segment from + t·(to − from), 0 < t < 1: the direction need not be a unit vector.
+    !scene.accel().occluded(from, to - from, 1.0 - 1e-6)
 }

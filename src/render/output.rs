@@ -52,11 +52,16 @@ pub fn write_image(film: &Film, path: &Path, exposure: f32) -> Result<(), Output
     let (w, h) = (film.width as usize, film.height as usize);
     let tmp = temp_path(path);
     let result = match format {
-        OutputFormat::Exr => exr::prelude::write_rgb_file(&tmp, w, h, |x, y| {
-            let c = means[y * w + x];
-            (c.x, c.y, c.z)
-        })
-        .map_err(|e| e.to_string()),
+        OutputFormat::Exr => {
+            use exr::prelude::*;
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let c: glam::Vec3 = means[y * w + x];
+                (c.x, c.y, c.z)
+            });
+            // Blocks compressed in parallel land in the file in whatever order they finish; written in order, the
+            // same image is the same file, byte for byte.
+            Image::from_channels((w, h), channels).write().non_parallel().to_file(&tmp).map_err(|e| e.to_string())
+        }
         OutputFormat::Png => {
             let scale = exposure.exp2();
             let bytes: Vec<u8> = means.iter().flat_map(|c| srgb_bytes(*c * scale)).collect();

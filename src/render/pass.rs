@@ -4,12 +4,16 @@
 
 use super::strategy::MisSettings;
 use super::{Film, ShadingPoint, Strategy, estimate_direct};
-use crate::math::SampleRng;
-use crate::scene::{Camera, CameraBasis, EmitterSampler, LightSelection, Scene, Triangle};
+use crate::math::{PixelStreams, SampleRng};
+use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::time::Duration;
+
+/// Passes of at least this many samples per pixel gather, once per pixel, the few triangles its camera rays
+/// can hit (an exact cull: see `scene::accel::frustum`); each camera ray then tests only those.
+const CONE_MIN_SAMPLES: u32 = 4;
 
 /// What a render is a function of, besides the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -101,10 +105,16 @@ impl<'a> Renderer<'a> {
                 }
                 let cpu = ThreadTime::now();
                 for (x, acc) in row.iter_mut().enumerate() {
-                    let pixel = y as u64 * width as u64 + x as u64;
+                    let streams = PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
+                    let (x, y) = (x as u32, y as u32);
+                    let cone = (count >= CONE_MIN_SAMPLES)
+                        .then(|| self.scene.accel().cone_candidates(self.camera.eye(), self.camera.pixel_corners(x, y)))
+                        .flatten();
                     for s in first..first + count {
-                        let mut rng = SampleRng::new(self.settings.seed, pixel, s as u64);
-                        let v = self.sample_pixel(x as u32, y as u32, &mut rng, &mut stats.rays);
+                        let mut rng = streams.sample(s as u64);
+                        let (dir, hit) = self.camera_ray(x, y, cone.as_ref(), &mut rng);
+                        stats.rays += 1;
+                        let v = hit.map_or(Vec3::ZERO, |hit| self.shade(dir, &hit, &mut rng, &mut stats.rays));
                         if v.is_finite() {
                             acc.add(v);
                         } else {
@@ -122,39 +132,27 @@ impl<'a> Renderer<'a> {
             })
     }
 
-    /// One sample of pixel (x, y): `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface seen through a
-    /// uniformly jittered position in the pixel (box filter).
+    /// A camera ray through a uniformly jittered position in pixel (x, y) (box filter) and its closest hit.
+    /// `cone`, when given, holds every triangle the pixel's camera rays can hit.
     #[inline]
-    pub fn sample_pixel(&self, x: u32, y: u32, rng: &mut SampleRng, rays: &mut u64) -> Vec3 {
+    fn camera_ray(&self, x: u32, y: u32, cone: Option<&ConeCandidates>, rng: &mut SampleRng) -> (Vec3, Option<Hit>) {
         let dir = self.camera.direction(x, y, rng.uniform_2d());
-        let eye = self.camera.eye();
-        *rays += 1;
-        let Some(hit) = self.scene.accel().closest_hit(eye, dir, f32::INFINITY) else { return Vec3::ZERO };
+        let hit = match cone {
+            Some(cone) => cone.closest_hit(dir, f32::INFINITY),
+            None => self.scene.accel().closest_hit(self.camera.eye(), dir, f32::INFINITY),
+        };
+        (dir, hit)
+    }
+
+    /// One sample of `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface x seen along the camera ray `dir`.
+    #[inline]
+    fn shade(&self, dir: Vec3, hit: &Hit, rng: &mut SampleRng, rays: &mut u64) -> Vec3 {
         let tri = &self.scene.triangles[hit.triangle as usize];
-        let p = hit_point(tri, eye, dir, hit.t);
+        let p = self.scene.hit_point(hit);
         let wo = -dir;
         let material = &self.scene.materials[tri.material as usize];
         let sp = ShadingPoint::new(p, tri.n, wo, material);
         let emitted = self.scene.emitted(hit.triangle, wo);
         emitted + estimate_direct(self.scene, &sp, &self.settings, self.emitters.as_ref(), rng, rays)
     }
-}
-
-/// The hit point from barycentrics on the triangle rather than `o + t·d`, whose error grows with the distance
-/// travelled (Ray Tracing Gems ch. 6): its error is then a few ULPs of the vertices.
-#[inline]
-fn hit_point(tri: &Triangle, o: Vec3, d: Vec3, t: f32) -> Vec3 {
-    let [v0, v1, v2] = tri.v;
-    let (e1, e2) = (v1 - v0, v2 - v0);
-    let pvec = d.cross(e2);
-    let det = e1.dot(pvec);
-    if det.abs() < 1e-30 {
-        return o + d * t;
-    }
-    let inv = 1.0 / det;
-    let tvec = o - v0;
-    let b1 = tvec.dot(pvec) * inv;
-    let b2 = d.dot(tvec.cross(e1)) * inv;
-    let p = v0 + e1 * b1.clamp(0.0, 1.0) + e2 * b2.clamp(0.0, 1.0);
-    if p.is_finite() { p } else { o + d * t }
 }

@@ -31,7 +31,13 @@ impl DiscreteDistribution {
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
         let u = u as f64;
-        let i = (self.cdf.partition_point(|&c| c <= u) - 1).min(self.pmf.len() - 1);
+        // The number of CDF entries after the leading 0 that are ≤ u; a branch-free count for a few entries.
+        let below = if self.cdf.len() <= 17 {
+            self.cdf[1..].iter().filter(|&&c| c <= u).count()
+        } else {
+            self.cdf.partition_point(|&c| c <= u) - 1
+        };
+        let i = below.min(self.pmf.len() - 1);
         (i, self.pmf[i])
     }
 

@@ -75,6 +75,18 @@ impl CameraBasis {
         (self.forward + self.right * ndc.x - self.up * ndc.y).normalize()
     }
 
+    /// Directions (not unit) through the corners of pixel (x, y), enlarged by 1/64 of a pixel on every side,
+    /// in order around it: every [`CameraBasis::direction`] of the pixel lies strictly inside the cone they span,
+    /// whatever the rounding.
+    pub fn pixel_corners(&self, x: u32, y: u32) -> [Vec3; 4] {
+        const MARGIN: f32 = 1.0 / 64.0;
+        let (lo, hi) = (-MARGIN, 1.0 + MARGIN);
+        [(lo, lo), (hi, lo), (hi, hi), (lo, hi)].map(|(jx, jy)| {
+            let ndc = (Vec2::new(x as f32 + jx, y as f32 + jy)) * self.inv_size * 2.0 - Vec2::ONE;
+            self.forward + self.right * ndc.x - self.up * ndc.y
+        })
+    }
+
     #[inline]
     pub fn eye(&self) -> Vec3 {
         self.eye

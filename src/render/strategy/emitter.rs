@@ -12,7 +12,7 @@ pub const DESCRIPTION: &str = "area-light sampling: triangle with p_Δ, uniform 
 pub const PDF: &str = "p(ω) = p_Δ ‖x−p‖² / (A_Δ |n_Δ·ω|)";
 
 /// Direction, its density given Δ, and the point on Δ.
-#[inline]
+#[inline(always)]
 pub fn sample(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
     let [a, b, c] = tri.v;
     let x = sample_uniform_triangle(rng.uniform_2d(), a, b, c);

@@ -34,7 +34,7 @@ impl LightTechnique {
         Self::ALL.into_iter().find(|t| t.name() == name)
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn sample(
         self,
         sp: &ShadingPoint,

@@ -1,0 +1,139 @@
+//! Building the 8-wide BVH: obvhs builds a binary BVH (PLOC clustering, reinsertion and SAH leaf collapse,
+//! Meister & Bittner 2018), which is collapsed top-down into nodes of up to eight children by repeatedly opening
+//! the child with the largest surface area (Wald et al., "Getting Rid of Packets", 2008). A subtree of at most
+//! eight triangles becomes one packet: testing eight triangles costs what testing one does.
+
+use super::node::{Child, Node8};
+use super::packet::TrianglePacket;
+use glam::Vec3;
+use obvhs::{
+    BvhBuildParams,
+    bvh2::{Bvh2, builder::build_bvh2_from_tris},
+    triangle::Triangle as ObvhsTriangle,
+};
+use std::time::Duration;
+
+/// Below this many node levels a subtree becomes one leaf, whatever its size; it bounds the traversal stack
+/// (at most seven entries per level) on pathological input.
+pub(super) const MAX_DEPTH: usize = 16;
+
+const WIDTH: usize = 8;
+
+pub(super) struct Built {
+    pub nodes: Vec<Node8>,
+    pub packets: Vec<TrianglePacket>,
+    pub root: Child,
+    /// `order[i]` = input index of the i-th stored triangle; packets refer to stored indices.
+    pub order: Vec<u32>,
+}
+
+/// Builds the tree over a non-empty triangle list.
+pub(super) fn build(positions: &[[Vec3; 3]]) -> Built {
+    let input: Vec<ObvhsTriangle> =
+        positions.iter().map(|[a, b, c]| ObvhsTriangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect();
+    let bvh = build_bvh2_from_tris(&input, BvhBuildParams::medium_build(), &mut Duration::default());
+    let mut builder =
+        Builder { counts: subtree_counts(&bvh), bvh: &bvh, positions, nodes: vec![], packets: vec![], order: vec![] };
+    let root = builder.child(0, 0);
+    Built { nodes: builder.nodes, packets: builder.packets, root, order: builder.order }
+}
+
+struct Builder<'a> {
+    bvh: &'a Bvh2,
+    /// Triangles under each binary node.
+    counts: Vec<u32>,
+    positions: &'a [[Vec3; 3]],
+    nodes: Vec<Node8>,
+    packets: Vec<TrianglePacket>,
+    order: Vec<u32>,
+}
+
+impl Builder<'_> {
+    /// The wide child standing for binary node `id`, at `depth` wide levels below the root.
+    fn child(&mut self, id: usize, depth: usize) -> Child {
+        if !self.splits(id) || depth >= MAX_DEPTH {
+            return self.leaf(id);
+        }
+        let first = self.bvh.nodes[id].first_index as usize;
+        let mut open = vec![first, first + 1];
+        while open.len() < WIDTH {
+            let widest = (0..open.len())
+                .filter(|&i| self.splits(open[i]))
+                .max_by(|&i, &j| self.half_area(open[i]).total_cmp(&self.half_area(open[j])));
+            let Some(i) = widest else { break };
+            let node = open.swap_remove(i);
+            let first = self.bvh.nodes[node].first_index as usize;
+            open.extend([first, first + 1]);
+        }
+        let slot = self.nodes.len();
+        self.nodes.push(Node8::new(&[]));
+        let children: Vec<([Vec3; 2], Child)> = open
+            .into_iter()
+            .map(|c| {
+                let aabb = self.bvh.nodes[c].aabb;
+                ([aabb.min.into(), aabb.max.into()], self.child(c, depth + 1))
+            })
+            .collect();
+        self.nodes[slot] = Node8::new(&children);
+        Child { first: slot as u32, packets: 0 }
+    }
+
+    /// Whether binary node `id` becomes a wide node rather than a leaf.
+    fn splits(&self, id: usize) -> bool {
+        !self.bvh.nodes[id].is_leaf() && self.counts[id] as usize > WIDTH
+    }
+
+    fn half_area(&self, id: usize) -> f32 {
+        self.bvh.nodes[id].aabb.half_area()
+    }
+
+    /// Every triangle under binary node `id`, eight to a packet.
+    fn leaf(&mut self, id: usize) -> Child {
+        let mut triangles = Vec::new();
+        let mut stack = vec![id];
+        while let Some(n) = stack.pop() {
+            let node = &self.bvh.nodes[n];
+            let first = node.first_index as usize;
+            if node.is_leaf() {
+                triangles.extend_from_slice(&self.bvh.primitive_indices[first..first + node.prim_count as usize]);
+            } else {
+                stack.extend([first + 1, first]);
+            }
+        }
+        let first_packet = self.packets.len() as u32;
+        for chunk in triangles.chunks(WIDTH) {
+            let lanes: Vec<([Vec3; 3], u32)> = chunk
+                .iter()
+                .map(|&input| {
+                    self.order.push(input);
+                    (self.positions[input as usize], self.order.len() as u32 - 1)
+                })
+                .collect();
+            self.packets.push(TrianglePacket::new(&lanes));
+        }
+        Child { first: first_packet, packets: self.packets.len() as u32 - first_packet }
+    }
+}
+
+/// The number of triangles under every node of the binary tree.
+fn subtree_counts(bvh: &Bvh2) -> Vec<u32> {
+    let mut preorder = Vec::with_capacity(bvh.nodes.len());
+    let mut stack = vec![0usize];
+    while let Some(n) = stack.pop() {
+        preorder.push(n);
+        if !bvh.nodes[n].is_leaf() {
+            let first = bvh.nodes[n].first_index as usize;
+            stack.extend([first, first + 1]);
+        }
+    }
+    let mut counts = vec![0u32; bvh.nodes.len()];
+    for &n in preorder.iter().rev() {
+        let node = &bvh.nodes[n];
+        counts[n] = if node.is_leaf() {
+            node.prim_count
+        } else {
+            counts[node.first_index as usize] + counts[node.first_index as usize + 1]
+        };
+    }
+    counts
+}

@@ -1,0 +1,168 @@
+//! Eight triangles in structure-of-arrays form, intersected with one ray at once by Möller & Trumbore's test
+//! ("Fast, Minimum Storage Ray/Triangle Intersection", 1997): with `e₁ = v₁ − v₀`, `e₂ = v₂ − v₀`,
+//! `P = d × e₂`, `T = o − v₀`, `Q = T × e₁` and `det = e₁·P`, the ray meets the plane at
+//! `t = (e₂·Q)/det` with barycentrics `u = (T·P)/det`, `v = (d·Q)/det`, inside the triangle when
+//! `u ≥ 0, v ≥ 0, u + v ≤ 1`. Both faces are hit.
+
+use super::ray::WideRay;
+use glam::Vec3;
+use wide::{CmpGe, CmpGt, CmpLe, CmpLt, f32x8};
+
+/// A hit inside a packet: the lane, the distance and the barycentrics of v₁ and v₂.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct LaneHit {
+    pub lane: usize,
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+}
+
+#[derive(Clone, Debug)]
+pub(super) struct TrianglePacket {
+    v0: [f32x8; 3],
+    e1: [f32x8; 3],
+    e2: [f32x8; 3],
+    /// The triangle in each lane (an index into the stored order); unused lanes hold a point (e₁ = e₂ = 0,
+    /// det = 0), which no ray hits.
+    pub ids: [u32; 8],
+}
+
+impl TrianglePacket {
+    /// Up to eight triangles, with their ids.
+    pub fn new(triangles: &[([Vec3; 3], u32)]) -> Self {
+        assert!(triangles.len() <= 8, "a packet holds at most eight triangles");
+        let mut soa = [[[0.0f32; 8]; 3]; 3];
+        let mut ids = [u32::MAX; 8];
+        for (lane, ([a, b, c], id)) in triangles.iter().enumerate() {
+            for (k, v) in [*a, *b - *a, *c - *a].into_iter().enumerate() {
+                for axis in 0..3 {
+                    soa[k][axis][lane] = v[axis];
+                }
+            }
+            ids[lane] = *id;
+        }
+        let [v0, e1, e2] = soa.map(|vec| vec.map(f32x8::new));
+        Self { v0, e1, e2, ids }
+    }
+
+    /// A packet of lanes taken from other packets (unused lanes left empty).
+    pub fn gather(lanes: &[(&TrianglePacket, usize)]) -> Self {
+        assert!(lanes.len() <= 8, "a packet holds at most eight triangles");
+        let mut soa = [[[0.0f32; 8]; 3]; 3];
+        let mut ids = [u32::MAX; 8];
+        for (i, &(packet, lane)) in lanes.iter().enumerate() {
+            for (k, vector) in [&packet.v0, &packet.e1, &packet.e2].into_iter().enumerate() {
+                for axis in 0..3 {
+                    soa[k][axis][i] = vector[axis].as_array_ref()[lane];
+                }
+            }
+            ids[i] = packet.ids[lane];
+        }
+        let [v0, e1, e2] = soa.map(|vec| vec.map(f32x8::new));
+        Self { v0, e1, e2, ids }
+    }
+
+    /// The vertices of the triangle in `lane`, or `None` for an unused lane.
+    pub fn vertices(&self, lane: usize) -> Option<[Vec3; 3]> {
+        if self.ids[lane] == u32::MAX {
+            return None;
+        }
+        let at = |v: &[f32x8; 3]| Vec3::from_array([0, 1, 2].map(|axis| v[axis].as_array_ref()[lane]));
+        let v0 = at(&self.v0);
+        Some([v0, v0 + at(&self.e1), v0 + at(&self.e2)])
+    }
+
+    /// Lanes hit at `0 < t < t_max` (bit i for lane i), with `(T·P, d·Q, e₂·Q)` and det in every lane. The
+    /// tests run on the numerators with det's sign folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so
+    /// no lane is divided until one is hit.
+    #[inline(always)]
+    fn test(&self, ray: &WideRay, t_max: f32) -> (u32, [f32x8; 4]) {
+        let [dx, dy, dz] = ray.d;
+        let [e1x, e1y, e1z] = self.e1;
+        let [e2x, e2y, e2z] = self.e2;
+        let (px, py, pz) = (dy.mul_sub(e2z, dz * e2y), dz.mul_sub(e2x, dx * e2z), dx.mul_sub(e2y, dy * e2x));
+        let det = e1x.mul_add(px, e1y.mul_add(py, e1z * pz));
+        let (tx, ty, tz) = (ray.o[0] - self.v0[0], ray.o[1] - self.v0[1], ray.o[2] - self.v0[2]);
+        let (qx, qy, qz) = (ty.mul_sub(e1z, tz * e1y), tz.mul_sub(e1x, tx * e1z), tx.mul_sub(e1y, ty * e1x));
+        let u = tx.mul_add(px, ty.mul_add(py, tz * pz));
+        let v = dx.mul_add(qx, dy.mul_add(qy, dz * qz));
+        let t = e2x.mul_add(qx, e2y.mul_add(qy, e2z * qz));
+        let abs_det = det.abs();
+        let (su, sv, st) = (u.flip_signs(det), v.flip_signs(det), t.flip_signs(det));
+        let zero = f32x8::ZERO;
+        let inside = su.cmp_ge(zero) & sv.cmp_ge(zero) & (su + sv).cmp_le(abs_det);
+        let ahead = st.cmp_gt(zero) & st.cmp_lt(f32x8::splat(t_max) * abs_det);
+        ((inside & ahead & abs_det.cmp_gt(zero)).move_mask() as u32, [t, u, v, det])
+    }
+
+    /// The nearest hit at `0 < t < t_max`.
+    #[inline(always)]
+    pub fn closest(&self, ray: &WideRay, t_max: f32) -> Option<LaneHit> {
+        let (mask, [t, u, v, det]) = self.test(ray, t_max);
+        if mask == 0 {
+            return None;
+        }
+        let inv = f32x8::ONE / det;
+        let t = (t * inv).to_array();
+        let mut best: Option<usize> = None;
+        let mut bits = mask;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if t[i] < t_max && best.is_none_or(|b| t[i] < t[b]) {
+                best = Some(i);
+            }
+        }
+        let lane = best?;
+        let (u, v) = ((u * inv).to_array()[lane], (v * inv).to_array()[lane]);
+        Some(LaneHit { lane, t: t[lane], u, v })
+    }
+
+    /// Whether any triangle is hit at `0 < t < t_max`.
+    #[inline(always)]
+    pub fn any(&self, ray: &WideRay, t_max: f32) -> bool {
+        self.test(ray, t_max).0 != 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Triangle i lies in the plane z = i + 1, so a ray up the z axis meets them in lane order.
+    fn stack(n: usize) -> TrianglePacket {
+        let tris: Vec<([Vec3; 3], u32)> = (0..n)
+            .map(|i| {
+                let z = i as f32 + 1.0;
+                ([Vec3::new(-1.0, -1.0, z), Vec3::new(3.0, -1.0, z), Vec3::new(-1.0, 3.0, z)], 10 + i as u32)
+            })
+            .collect();
+        TrianglePacket::new(&tris)
+    }
+
+    #[test]
+    fn the_nearest_lane_is_reported_with_its_barycentrics() {
+        let packet = stack(8);
+        let ray = WideRay::new(Vec3::new(0.0, 0.0, 2.5), Vec3::Z);
+        let hit = packet.closest(&ray, f32::INFINITY).unwrap();
+        assert_eq!((hit.lane, packet.ids[hit.lane]), (2, 12));
+        assert!((hit.t - 0.5).abs() < 1e-6);
+        // (0, 0) = v₀ + u e₁ + v e₂ with e₁ = (4, 0), e₂ = (0, 4) from v₀ = (−1, −1): u = v = 1/4.
+        assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.25).abs() < 1e-6);
+        assert!(packet.closest(&ray, 0.5).is_none(), "t_max is exclusive");
+        assert!(packet.any(&ray, 0.6));
+        let down = WideRay::new(Vec3::new(0.0, 0.0, 2.5), -Vec3::Z);
+        assert_eq!(packet.closest(&down, f32::INFINITY).unwrap().lane, 1, "back faces are hit too");
+    }
+
+    #[test]
+    fn misses_unused_lanes_parallel_rays_and_the_outside() {
+        let packet = stack(3);
+        let up = WideRay::new(Vec3::new(0.0, 0.0, 3.5), Vec3::Z);
+        assert!(packet.closest(&up, f32::INFINITY).is_none(), "lanes 3..8 are unused");
+        let parallel = WideRay::new(Vec3::new(-5.0, 0.0, 1.0), Vec3::X);
+        assert!(!packet.any(&parallel, f32::INFINITY));
+        let outside = WideRay::new(Vec3::new(2.0, 2.0, 0.0), Vec3::Z);
+        assert!(!packet.any(&outside, f32::INFINITY));
+    }
+}

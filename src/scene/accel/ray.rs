@@ -1,0 +1,36 @@
+//! A ray broadcast to eight SIMD lanes, with what the slab test needs precomputed once per ray.
+
+use glam::{Vec3, Vec3A};
+use wide::f32x8;
+
+/// Directions components smaller than this are replaced by it (with their sign), so 1/d stays finite and the
+/// slab test never computes 0·∞.
+const MIN_COMPONENT: f32 = 1e-30;
+
+pub(super) struct WideRay {
+    pub o: [f32x8; 3],
+    pub d: [f32x8; 3],
+    pub inv_d: [f32x8; 3],
+    /// Per axis, the index in a node's `[min x, min y, min z, max x, max y, max z]` of the plane the ray
+    /// enters by (the min plane when it travels towards +axis), and of the one it leaves by.
+    pub near: [usize; 3],
+    pub far: [usize; 3],
+}
+
+impl WideRay {
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        let d = Vec3A::from(dir);
+        let tiny = d.abs().cmplt(Vec3A::splat(MIN_COMPONENT));
+        let inv = Vec3A::select(tiny, Vec3A::splat(MIN_COMPONENT).copysign(d), d).recip();
+        let negative = inv.is_negative_bitmask();
+        let near = [0, 1, 2].map(|a| if negative & (1 << a) != 0 { a + 3 } else { a });
+        Self {
+            o: origin.to_array().map(f32x8::splat),
+            d: dir.to_array().map(f32x8::splat),
+            inv_d: inv.to_array().map(f32x8::splat),
+            near,
+            far: near.map(|i| (i + 3) % 6),
+        }
+    }
+}
