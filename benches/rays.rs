@@ -1,5 +1,6 @@
 //! Raw BVH throughput: closest-hit and occlusion rays per second on the bundled scenes, with the rays an
-//! integrator would trace (camera rays, then shadow segments from the hit points to points on the lights).
+//! integrator would trace (camera rays, then shadow segments from the hit points to points on the lights); and
+//! camera rays through each pixel's cone of candidate triangles, as the integrator traces them.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
@@ -65,6 +66,35 @@ fn rays(c: &mut Criterion) {
                     blocked += scene.accel().occluded(o, d, t) as u32;
                 }
                 black_box(blocked)
+            })
+        });
+        // Cones of the first 4 096 pixels that have one (gathered outside the timing, as the integrator gathers
+        // each once per pass), 16 jittered camera rays each.
+        let basis = scene.camera.basis();
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        let cones: Vec<_> = (0..w * h)
+            .filter_map(|i| {
+                let (x, y) = (i % w, i / w);
+                scene.accel().cone_candidates(basis.eye(), basis.pixel_corners(x, y)).map(|c| (x, y, c))
+            })
+            .take(4096)
+            .collect();
+        let rays: Vec<_> = cones
+            .iter()
+            .enumerate()
+            .flat_map(|(k, (x, y, _))| {
+                let mut rng = SampleRng::new(2, k as u64, 0);
+                (0..16).map(move |_| (k, basis.direction(*x, *y, rng.uniform_2d())))
+            })
+            .collect();
+        group.throughput(Throughput::Elements(rays.len() as u64));
+        group.bench_function("camera_cone", |b| {
+            b.iter(|| {
+                let mut hits = 0u32;
+                for &(k, d) in &rays {
+                    hits += cones[k].2.closest_hit(d, f32::INFINITY).is_some() as u32;
+                }
+                black_box(hits)
             })
         });
         group.finish();

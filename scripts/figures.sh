@@ -15,3 +15,7 @@ for scene in cornell-box veach-mis near-light default; do
       -o "screenshots/$scene-$strategy.png"
   done
 done
+# The near-light close-ups: 4 spp, exposure −10, where only emitter sampling is grainy around the light.
+for strategy in emitter solid-angle projected-solid-angle; do
+  $bin render near-light --strategy "$strategy" --spp 4 --seed 1 --exposure -10 -o "screenshots/near-light-closeup-$strategy.png"
+done
