@@ -1,10 +1,10 @@
 //! Raw BVH throughput: closest-hit and occlusion rays per second on the bundled scenes, with the rays an
 //! integrator would trace (camera rays, then shadow segments from the hit points to points on the lights); and
 //! camera rays through each pixel's cone of candidate triangles, as the integrator traces them; and, in the same
-//! run, the rays per second of the `emitter` integrator itself (a 128×128 pass of 16 samples per pixel), so the two
-//! rates compare under the same machine load.
+//! run, the rays per second of the `emitter` integrator itself (passes of 32 samples per pixel over the scene's
+//! image), so the two rates compare under the same machine load.
 
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use illumlab::math::{SampleRng, offset_ray_origin};
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
@@ -100,19 +100,20 @@ fn rays(c: &mut Criterion) {
                 black_box(hits)
             })
         });
-        // The integrator, on one thread like the rays above: every ray it traces (camera and shadow rays), with its sampling and shading around them.
-        let mut small = scene.clone();
-        (small.camera.width, small.camera.height) = (128, 128);
-        let renderer = Renderer::new(&small, RenderSettings { strategy: Strategy::Emitter, ..Default::default() });
-        let mut film = Film::new(128, 128);
+        // The integrator, on one thread like the rays above: every ray it traces (camera and shadow rays), with its
+        // sampling and shading around them, in passes of 32 samples per pixel over the scene's own image.
+        const SPP: u32 = 32;
+        let renderer = Renderer::new(&scene, RenderSettings { strategy: Strategy::Emitter, ..Default::default() });
+        let mut film = Film::new(w, h);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
-        let rays_per_pass = pool.install(|| renderer.render_pass(&mut film, 0, 16, &|| false)).rays;
-        let mut first = 16;
+        let rays_per_pass = pool.install(|| renderer.render_pass(&mut film, 0, SPP, &|| false)).rays;
+        let mut first = SPP;
         group.throughput(Throughput::Elements(rays_per_pass));
+        group.sample_size(10).sampling_mode(SamplingMode::Flat).measurement_time(std::time::Duration::from_secs(6));
         group.bench_function("integrator_emitter", |b| {
             b.iter(|| {
-                let stats = pool.install(|| renderer.render_pass(&mut film, first, 16, &|| false));
-                first += 16;
+                let stats = pool.install(|| renderer.render_pass(&mut film, first, SPP, &|| false));
+                first += SPP;
                 black_box(stats.rays)
             })
         });
