@@ -1,7 +1,8 @@
 //! Ray queries for the integrator: the closest hit for camera and BRDF rays, any hit with early exit for shadow
 //! rays. obvhs builds a binary BVH, which is collapsed into an 8-wide one whose nodes test eight child boxes
 //! and whose leaves test eight triangles against one ray at once (f32x8): one ray, wide nodes, as in Embree's
-//! BVH8 (Wald et al. 2014). Coherence between rays is never assumed, so every strategy's rays run as fast.
+//! BVH8 (Wald et al. 2014). A single ray needs no coherence with others, so every strategy's rays run as fast;
+//! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull.
 
 mod build;
 mod frustum;
@@ -25,7 +26,7 @@ pub struct Accel {
     root: Option<Child>,
 }
 
-/// A closest hit: the triangle (in stored order), the distance along the unit direction, and the barycentric
+/// A closest hit: the triangle (in stored order), the distance (in lengths of the ray's direction), and the barycentric
 /// coordinates of the hit point, `x = v₀ + u (v₁ − v₀) + v (v₂ − v₀)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit {
