@@ -37,6 +37,18 @@ fn step_until(h: &mut Harness<'_, Viewer>, what: &str, pred: impl Fn(&Viewer) ->
     }
 }
 
+/// Opens the combo box that shows `current` and clicks `choice` in its popup.
+fn choose_in_combo_box(h: &mut Harness<'_, Viewer>, current: &str, choice: &str) {
+    h.get_all_by_role(Role::ComboBox)
+        .find(|n| n.value().as_deref() == Some(current))
+        .unwrap_or_else(|| panic!("no combo box shows {current}"))
+        .click();
+    // The popup opens on the frame after the click.
+    h.step();
+    h.step();
+    h.get_by_label(choice).click();
+}
+
 #[test]
 fn choosing_a_strategy_by_its_label_changes_the_render_and_restarts() {
     let mut h = harness(viewer());
@@ -150,14 +162,7 @@ fn a_broken_scene_file_shows_an_error_and_the_previous_scene_stays_usable() {
 fn choosing_a_bundled_scene_loads_it_in_the_background() {
     let mut h = harness(viewer());
     step_until(&mut h, "a frame", |v| v.frame().is_some());
-    h.get_all_by_role(Role::ComboBox)
-        .find(|n| n.value().as_deref() == Some("cornell-box"))
-        .expect("the scene picker shows the current scene")
-        .click();
-    // The popup opens on the frame after the click.
-    h.step();
-    h.step();
-    h.get_by_label("near-light").click();
+    choose_in_combo_box(&mut h, "cornell-box", "near-light");
     h.step();
     step_until(&mut h, "the near-light frame", |v| v.frame().is_some_and(|f| f.scene_name == "near-light"));
     assert_eq!(h.state().scene().name, "near-light");
@@ -288,13 +293,7 @@ fn identical_estimators_differ_nowhere_and_error_views_switch() {
     let mut h = harness(v);
     h.key_press(egui::Key::C);
     h.step();
-    h.get_all_by_role(Role::ComboBox)
-        .find(|n| n.value().as_deref() == Some("cosine"))
-        .expect("B's strategy picker")
-        .click();
-    h.step();
-    h.step();
-    h.get_by_label("emitter").click();
+    choose_in_combo_box(&mut h, "cosine", "emitter");
     h.step();
     step_until(&mut h, "both lanes at the target", |v| {
         v.frame_b().is_some_and(|b| b.settings.strategy == Strategy::Emitter && b.spp == 4)
