@@ -1,7 +1,7 @@
 //! The worker end to end: restarts, targets, common random numbers, budgets and the reference cache.
 
 use super::*;
-use crate::measure::ReferenceOrigin;
+use crate::measure::{Reference, ReferenceOrigin};
 use crate::render::Strategy;
 use crate::scene::load_scene;
 
