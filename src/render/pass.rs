@@ -160,17 +160,14 @@ impl<'a> Renderer<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::load_scene;
+    use crate::scene::every_bundled_scene;
 
     /// One pass of 16 samples per pixel (camera rays through each pixel's cone) and 16 passes of one sample
     /// (a full traversal for every camera ray) give the same film bit for bit, on every bundled scene and for
     /// strategies that trace shadow rays and BRDF rays.
     #[test]
     fn any_split_into_passes_gives_the_same_film() {
-        for name in ["cornell-box", "veach-mis", "near-light", "default"] {
-            let scene = load_scene(name).unwrap();
-            let mut camera = scene.camera;
-            (camera.width, camera.height) = (48, 36);
+        for (name, scene, camera) in every_bundled_scene(48, 36) {
             for strategy in [Strategy::Emitter, Strategy::Brdf, Strategy::Mis] {
                 let settings = RenderSettings { strategy, seed: 3, ..Default::default() };
                 let renderer = Renderer::with_camera(&scene, settings, &camera);

@@ -36,6 +36,19 @@ pub const BUNDLED_SCENES: &[BundledScene] =
 /// The scene the viewer opens on.
 pub const DEFAULT_SCENE: &str = "default";
 
+/// Every bundled scene, loaded, with its camera set to `width × height` (for tests at low resolution).
+#[cfg(test)]
+pub(crate) fn every_bundled_scene(
+    width: u32,
+    height: u32,
+) -> impl Iterator<Item = (&'static str, super::Scene, super::Camera)> {
+    BUNDLED_SCENES.iter().map(move |b| {
+        let scene = super::load_scene(b.name).expect("a bundled scene loads");
+        let camera = super::Camera { width, height, ..scene.camera };
+        (b.name, scene, camera)
+    })
+}
+
 pub(super) fn find(name: &str) -> Option<&'static BundledScene> {
     BUNDLED_SCENES.iter().find(|s| s.name == name)
 }

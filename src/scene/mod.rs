@@ -11,6 +11,8 @@ mod load;
 mod material;
 
 pub use accel::{Accel, ConeCandidates, Hit};
+#[cfg(test)]
+pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
 pub use emitters::{EmitterSampler, LightSelection};

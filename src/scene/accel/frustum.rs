@@ -68,17 +68,14 @@ impl ConeCandidates {
 #[cfg(test)]
 mod tests {
     use crate::math::{ONE_MINUS_EPSILON, SampleRng};
-    use crate::scene::load_scene;
+    use crate::scene::every_bundled_scene;
     use glam::Vec2;
 
     /// Every camera ray of a pixel, its corners included, finds through the pixel's cone the hit the full
     /// traversal finds, at the same distance bit for bit.
     #[test]
     fn cones_find_the_closest_hit_of_every_camera_ray() {
-        for name in ["cornell-box", "veach-mis", "near-light", "default"] {
-            let scene = load_scene(name).unwrap();
-            let mut camera = scene.camera;
-            (camera.width, camera.height) = (96, 72);
+        for (name, scene, camera) in every_bundled_scene(96, 72) {
             let basis = camera.basis();
             let mut cones = 0;
             for y in 0..camera.height {
