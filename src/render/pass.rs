@@ -171,7 +171,8 @@ mod tests {
             for strategy in [Strategy::Emitter, Strategy::Brdf, Strategy::Mis] {
                 let settings = RenderSettings { strategy, seed: 3, ..Default::default() };
                 let renderer = Renderer::with_camera(&scene, settings, &camera);
-                let (mut whole, mut split) = (Film::new(48, 36), Film::new(48, 36));
+                let (mut whole, mut split) =
+                    (Film::new(camera.width, camera.height), Film::new(camera.width, camera.height));
                 renderer.render_pass(&mut whole, 0, 16, &|| false);
                 for s in 0..16 {
                     renderer.render_pass(&mut split, s, 1, &|| false);
