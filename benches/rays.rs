@@ -1,49 +1,60 @@
 //! Raw BVH throughput: closest-hit and occlusion rays per second on the bundled scenes, with the rays an
-//! integrator would trace (camera rays, then shadow segments from the hit points to points on the lights); and
-//! camera rays through each pixel's cone of candidate triangles, as the integrator traces them; and, in the same
-//! run, the rays per second of the `emitter` integrator itself (passes of 32 samples per pixel over the scene's
-//! image), so the two rates compare under the same machine load.
+//! integrator would trace (eight samples in each of 8 192 pixels spread over the image: camera rays, then
+//! shadow segments from the hit points to points on the lights), traced one at a time; the same shadow rays
+//! eight at a time (a pixel's, one per lane), and camera rays through each pixel's cone of candidate
+//! triangles, as the integrator traces them; and, in the same run, the rays per second of the `emitter`
+//! integrator itself (passes of 32 samples per pixel over the scene's image), so the rates compare under the
+//! same machine load.
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use illumlab::math::{SampleRng, offset_ray_origin};
+use illumlab::math::{SampleRng, Vec3x8, offset_ray_origin};
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
 use illumlab::sampling::sample_uniform_triangle;
 use illumlab::scene::{EmitterSampler, LightSelection, Scene, load_scene};
 use std::hint::black_box;
 
 const RAYS: usize = 1 << 16;
+const PER_PIXEL: usize = 8;
 
 struct Workload {
     primary: Vec<(Vec3, Vec3)>,
-    shadow: Vec<(Vec3, Vec3, f32)>,
+    /// Segments `o + t·d`, 0 < t < 0.999, from a hit point to a point on a light.
+    shadow: Vec<(Vec3, Vec3)>,
+    /// The same segments grouped by pixel: origins, directions and the lanes in use.
+    shadow_lanes: Vec<(Vec3x8, Vec3x8, u32)>,
 }
 
 fn workload(scene: &Scene) -> Workload {
     let basis = scene.camera.basis();
     let emitters = EmitterSampler::new(scene, LightSelection::Power).expect("scene has emitters");
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let mut primary = Vec::with_capacity(RAYS);
-    let mut shadow = Vec::with_capacity(RAYS);
-    for i in 0..RAYS as u64 {
-        let mut rng = SampleRng::new(1, i, 0);
-        let (x, y) = ((i % w as u64) as u32, ((i / w as u64) % h as u64) as u32);
-        let dir = basis.direction(x, y, rng.uniform_2d());
-        primary.push((basis.eye(), dir));
-        if let Some(hit) = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY) {
+    let pixels = RAYS / PER_PIXEL;
+    let mut work = Workload { primary: Vec::new(), shadow: Vec::new(), shadow_lanes: Vec::new() };
+    for k in 0..pixels as u64 {
+        let pixel = k * (w * h) as u64 / pixels as u64;
+        let (x, y) = ((pixel % w as u64) as u32, (pixel / w as u64) as u32);
+        let mut lanes = ([Vec3::ZERO; PER_PIXEL], [Vec3::ZERO; PER_PIXEL], 0u32);
+        for s in 0..PER_PIXEL as u64 {
+            let mut rng = SampleRng::new(1, pixel, s);
+            let dir = basis.direction(x, y, rng.uniform_2d());
+            work.primary.push((basis.eye(), dir));
+            let Some(hit) = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY) else { continue };
             let tri = &scene.triangles[hit.triangle as usize];
             let n = if tri.n.dot(dir) < 0.0 { tri.n } else { -tri.n };
             let p = offset_ray_origin(basis.eye() + dir * hit.t, n);
             let Some((t, _)) = emitters.pick(scene, p, rng.uniform()) else { continue };
             let [a, b, c] = scene.triangles[t as usize].v;
             let d = sample_uniform_triangle(rng.uniform_2d(), a, b, c) - p;
-            let dist = d.length();
-            if dist > 0.0 {
-                shadow.push((p, d / dist, dist * 0.999));
-            }
+            let l = lanes.2.count_ones() as usize;
+            (lanes.0[l], lanes.1[l], lanes.2) = (p, d, lanes.2 | 1 << l);
+            work.shadow.push((p, d));
+        }
+        if lanes.2 != 0 {
+            work.shadow_lanes.push((Vec3x8::from_lanes(&lanes.0), Vec3x8::from_lanes(&lanes.1), lanes.2));
         }
     }
-    Workload { primary, shadow }
+    work
 }
 
 fn rays(c: &mut Criterion) {
@@ -65,8 +76,17 @@ fn rays(c: &mut Criterion) {
         group.bench_function("occluded", |b| {
             b.iter(|| {
                 let mut blocked = 0u32;
-                for &(o, d, t) in &work.shadow {
-                    blocked += scene.accel().occluded(o, d, t) as u32;
+                for &(o, d) in &work.shadow {
+                    blocked += scene.accel().occluded(o, d, 0.999) as u32;
+                }
+                black_box(blocked)
+            })
+        });
+        group.bench_function("occluded_eight_lanes", |b| {
+            b.iter(|| {
+                let mut blocked = 0u32;
+                for (o, d, active) in &work.shadow_lanes {
+                    blocked += scene.accel().occluded_lanes(o, d, 0.999, *active).count_ones();
                 }
                 black_box(blocked)
             })

@@ -3,7 +3,7 @@
 
 use super::strategy::{DirectionSample, MisSettings, Target};
 use super::{RenderSettings, ShadingPoint, Strategy};
-use crate::math::{SampleRng, offset_ray_origin};
+use crate::math::{SampleRng, Vec3x8, offset_ray_origin, offset_ray_origins};
 use crate::scene::{EmitterSampler, Scene};
 use glam::Vec3;
 
@@ -32,30 +32,41 @@ pub fn estimate_direct(
 /// it reached. `None` where it is zero.
 #[inline]
 fn integrand(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, rays: &mut u64) -> Option<(Vec3, (u32, Vec3))> {
+    match s.target {
+        Target::Trace => {
+            let (f, cos) = brdf_and_cos(sp, s)?;
+            *rays += 1;
+            let origin = offset_ray_origin(sp.p, sp.n);
+            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY)?;
+            let li = scene.emitted(hit.triangle, -s.wi);
+            (li != Vec3::ZERO).then_some((f * li * cos, (hit.triangle, scene.hit_point(&hit))))
+        }
+        Target::Emitter { triangle, point } => {
+            let (value, n_x) = unshadowed(scene, sp, s, triangle)?;
+            visible(scene, sp.p, sp.n, point, n_x, rays).then_some((value, (triangle, point)))
+        }
+    }
+}
+
+/// f_r and ω·n for a sampled direction; `None` where the sample contributes nothing whatever arrives along ω
+/// (below the surface, zero density, f_r = 0).
+#[inline]
+fn brdf_and_cos(sp: &ShadingPoint, s: &DirectionSample) -> Option<(Vec3, f32)> {
     let cos = sp.n.dot(s.wi);
     if !(cos > 0.0 && s.pdf > 0.0) {
         return None;
     }
     let f = sp.material.eval_brdf(sp.n, sp.wo, s.wi);
-    if f == Vec3::ZERO {
-        return None;
-    }
-    let (li, reached) = match s.target {
-        Target::Trace => {
-            *rays += 1;
-            let origin = offset_ray_origin(sp.p, sp.n);
-            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY)?;
-            (scene.emitted(hit.triangle, -s.wi), (hit.triangle, scene.hit_point(&hit)))
-        }
-        Target::Emitter { triangle, point } => {
-            let le = scene.emitted(triangle, -s.wi);
-            if le == Vec3::ZERO || !visible(scene, sp.p, sp.n, point, scene.triangles[triangle as usize].n, rays) {
-                return None;
-            }
-            (le, (triangle, point))
-        }
-    };
-    (li != Vec3::ZERO).then_some((f * li * cos, reached))
+    (f != Vec3::ZERO).then_some((f, cos))
+}
+
+/// For a direction aimed at a point on the emitter triangle `triangle`: `f_r L_e (ω·n)`, which arrives if the
+/// shadow ray gets through, and the triangle's normal (for the ray's far end). `None` where it is zero anyway.
+#[inline]
+pub(super) fn unshadowed(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, triangle: u32) -> Option<(Vec3, Vec3)> {
+    let (f, cos) = brdf_and_cos(sp, s)?;
+    let le = scene.emitted(triangle, -s.wi);
+    (le != Vec3::ZERO).then(|| (f * le * cos, scene.triangles[triangle as usize].n))
 }
 
 /// Veach's multi-sample MIS estimator (see [`super::strategy::mis`]).
@@ -97,6 +108,26 @@ pub fn visible(scene: &Scene, p: Vec3, n: Vec3, x: Vec3, n_x: Vec3, rays: &mut u
     *rays += 1;
     let from = offset_ray_origin(p, n);
     let to = offset_ray_origin(x, n_x);
-    // The segment from + t·(to − from), 0 < t < 1: the direction need not be a unit vector.
-    !scene.accel().occluded(from, to - from, 1.0 - 1e-6)
+    !scene.accel().occluded(from, to - from, SEGMENT_END)
 }
+
+/// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i); returns
+/// the visible ones. Lane i's answer is `visible`'s, bit for bit.
+#[inline]
+pub(super) fn visible_lanes(
+    scene: &Scene,
+    p: Vec3x8,
+    n: Vec3x8,
+    x: Vec3x8,
+    n_x: Vec3x8,
+    active: u32,
+    rays: &mut u64,
+) -> u32 {
+    *rays += active.count_ones() as u64;
+    let from = offset_ray_origins(p, n);
+    let to = offset_ray_origins(x, n_x);
+    active & !scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, active)
+}
+
+/// Shadow rays run along `from + t·(to − from)` for 0 < t < 1 − 10⁻⁶ (the direction is not a unit vector).
+const SEGMENT_END: f32 = 1.0 - 1e-6;

@@ -2,6 +2,7 @@
 
 mod estimator;
 mod film;
+mod lanes;
 mod output;
 mod pass;
 mod shading;

@@ -1,8 +1,10 @@
 //! Pinhole camera. It looks from `eye` to `target`; `up` is up in the image and the image's right is
 //! forward × up (as in Mitsuba and pbrt). Row 0 is the image's top row.
 
+use crate::math::Vec3x8;
 use crate::scene::SceneError;
 use glam::{Vec2, Vec3};
+use wide::f32x8;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -73,6 +75,17 @@ impl CameraBasis {
     pub fn direction(&self, x: u32, y: u32, jitter: Vec2) -> Vec3 {
         let ndc = (Vec2::new(x as f32, y as f32) + jitter) * self.inv_size * 2.0 - Vec2::ONE;
         (self.forward + self.right * ndc.x - self.up * ndc.y).normalize()
+    }
+
+    /// [`CameraBasis::direction`] for eight jitters at once, one per lane, each equal to the scalar one bit for bit.
+    #[inline]
+    pub fn directions(&self, x: u32, y: u32, jitter: &[Vec2; 8]) -> Vec3x8 {
+        let ndc = |pixel: u32, jitter: f32x8, inv_size: f32| {
+            (f32x8::splat(pixel as f32) + jitter) * f32x8::splat(inv_size) * f32x8::splat(2.0) - f32x8::ONE
+        };
+        let ndc_x = ndc(x, f32x8::new(jitter.map(|j| j.x)), self.inv_size.x);
+        let ndc_y = ndc(y, f32x8::new(jitter.map(|j| j.y)), self.inv_size.y);
+        (Vec3x8::splat(self.forward) + Vec3x8::splat(self.right) * ndc_x - Vec3x8::splat(self.up) * ndc_y).normalize()
     }
 
     /// Directions (not unit) through the corners of pixel (x, y), enlarged by 1/64 of a pixel on every side,

@@ -10,8 +10,10 @@ use super::packet::TrianglePacket;
 use super::ray::WideRay;
 use super::traverse::STACK;
 use super::{Accel, Hit};
+use crate::math::Vec3x8;
 use arrayvec::ArrayVec;
 use glam::Vec3;
+use wide::f32x8;
 
 /// The triangles a cone of rays from one apex can hit, in one packet.
 pub struct ConeCandidates {
@@ -63,16 +65,25 @@ impl ConeCandidates {
         let h = self.packet.closest(&WideRay::new(self.apex, dir), t_max)?;
         Some(Hit { triangle: self.packet.ids[h.lane], t: h.t, u: h.u, v: h.v })
     }
+
+    /// [`ConeCandidates::closest_hit`] for eight directions at once (one per lane; those in `active`, all bits
+    /// set): lane i gets direction i's hit, bit for bit.
+    #[inline]
+    pub fn closest_hits(&self, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<Hit>; 8] {
+        let hits = self.packet.closest_of_rays(self.apex, dirs, active, t_max);
+        hits.map(|h| h.map(|h| Hit { triangle: self.packet.ids[h.lane], t: h.t, u: h.u, v: h.v }))
+    }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
     use crate::math::{ONE_MINUS_EPSILON, SampleRng};
     use crate::scene::every_bundled_scene;
     use glam::Vec2;
 
     /// Every camera ray of a pixel, its corners included, finds through the pixel's cone the hit the full
-    /// traversal finds, at the same distance bit for bit.
+    /// traversal finds, at the same distance bit for bit; eight rays at once find what each finds alone.
     #[test]
     fn cones_find_the_closest_hit_of_every_camera_ray() {
         for (name, scene, camera) in every_bundled_scene(96, 72) {
@@ -91,7 +102,18 @@ mod tests {
                         (0.0, ONE_MINUS_EPSILON),
                         (ONE_MINUS_EPSILON, ONE_MINUS_EPSILON),
                     ];
-                    let jitters = corners.into_iter().map(Vec2::from).chain((0..8).map(|_| rng.uniform_2d()));
+                    let random: [Vec2; 8] = std::array::from_fn(|_| rng.uniform_2d());
+                    // Eight directions at once, and their hits through the cone, lane by lane as alone.
+                    let dirs = basis.directions(x, y, &random);
+                    let lanes = cone.closest_hits(&dirs, f32x8::splat(f32::from_bits(u32::MAX)), f32::INFINITY);
+                    for (l, jitter) in random.iter().enumerate() {
+                        let dir = basis.direction(x, y, *jitter);
+                        assert_eq!(dirs.lane(l).to_array().map(f32::to_bits), dir.to_array().map(f32::to_bits));
+                        let alone = cone.closest_hit(dir, f32::INFINITY);
+                        let key = |h: Option<Hit>| h.map(|h| (h.triangle, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
+                        assert_eq!(key(lanes[l]), key(alone), "{name} pixel ({x}, {y}), lane {l}");
+                    }
+                    let jitters = corners.into_iter().map(Vec2::from).chain(random);
                     for jitter in jitters.collect::<Vec<_>>() {
                         let dir = basis.direction(x, y, jitter);
                         let full = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY);

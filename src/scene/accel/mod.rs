@@ -50,7 +50,7 @@ impl Accel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::SampleRng;
+    use crate::math::{SampleRng, Vec3x8};
 
     /// Whether a ray hits a triangle, decided in f64 with a margin: away from edges (and from t = 0 and t_max),
     /// and for rays that are not grazing, float rounding cannot change the answer, so the BVH must agree; within
@@ -158,6 +158,39 @@ mod tests {
         for (n, size) in [(1, 4.0), (7, 3.0), (8, 3.0), (9, 3.0), (100, 2.0), (3000, 0.8)] {
             check_against_brute_force(&random_soup(n, size, n as u64), 4000);
         }
+    }
+
+    /// Eight rays walking the BVH together, one per lane, answer as each does alone, bit for bit: bundles from
+    /// nearby origins towards one region (as a pixel's shadow rays) and bundles of unrelated rays, with some
+    /// lanes inactive, on soups of every size.
+    #[test]
+    fn eight_rays_together_answer_as_each_alone() {
+        let mut occluded = 0;
+        for (n, size) in [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)] {
+            let tris = random_soup(n, size, 40 + n as u64);
+            let (accel, _) = Accel::build(&tris);
+            for group in 0..1500u64 {
+                let mut rng = SampleRng::new(17, group, n as u64);
+                let mut point =
+                    |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
+                let (centre, target) = (point(16.0), point(16.0));
+                let coherent = group % 2 == 0;
+                let origins: [Vec3; 8] =
+                    std::array::from_fn(|_| if coherent { centre + point(0.5) } else { point(16.0) });
+                let ends: [Vec3; 8] = std::array::from_fn(|_| if coherent { target + point(2.0) } else { point(16.0) });
+                let dirs: [Vec3; 8] = std::array::from_fn(|l| ends[l] - origins[l]);
+                let active = (group as u32).wrapping_mul(0x9e37_79b9) >> 24 | 1;
+                let t_max = [1.0 - 1e-6, 0.5, f32::INFINITY][group as usize % 3];
+                let bits =
+                    accel.occluded_lanes(&Vec3x8::from_lanes(&origins), &Vec3x8::from_lanes(&dirs), t_max, active);
+                for l in 0..8 {
+                    let alone = active & (1 << l) != 0 && accel.occluded(origins[l], dirs[l], t_max);
+                    assert_eq!(bits & (1 << l) != 0, alone, "soup {n}, group {group}, lane {l}");
+                    occluded += alone as u32;
+                }
+            }
+        }
+        assert!(occluded > 2000, "only {occluded} rays occluded: the test checks too little");
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! An 8-wide BVH node: the boxes of up to eight children in structure-of-arrays form, tested against one ray at
 //! once with the slab test (Kay & Kajiya 1986) made conservative as in Ize, "Robust BVH Ray Traversal" (2013).
 
-use super::ray::WideRay;
+use super::ray::{RayLanes, WideRay};
 use glam::Vec3;
 use wide::{CmpLe, CmpLt, f32x8};
 
@@ -68,6 +68,28 @@ impl Node8 {
         let t_exit = slab(ray.far, 0).fast_min(slab(ray.far, 1)).fast_min(slab(ray.far, 2));
         let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));
         (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
+    }
+
+    /// The rays of `rays` (bit i for lane i) whose slab test against child `k`'s box passes: bit i is bit k of
+    /// [`Node8::intersect`] for ray i, bit for bit (the same operations on the same values).
+    #[inline(always)]
+    pub fn intersect_lanes(&self, k: usize, rays: &RayLanes, t_max: f32) -> u32 {
+        let slab = |a: usize, near: bool| {
+            let (lo, hi) =
+                (f32x8::splat(self.bounds[a].as_array_ref()[k]), f32x8::splat(self.bounds[a + 3].as_array_ref()[k]));
+            let plane = if near { rays.negative[a].blend(hi, lo) } else { rays.negative[a].blend(lo, hi) };
+            (plane - rays.o[a]) * rays.inv_d[a]
+        };
+        let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
+        let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
+        let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));
+        t_enter.cmp_le(t_exit).move_mask() as u32
+    }
+
+    /// Bit i set when lane i holds a child.
+    #[inline(always)]
+    pub fn used(&self) -> u32 {
+        self.used
     }
 
     /// The children whose box is not wholly on the negative side of any of the planes through `apex` with

@@ -4,7 +4,8 @@
 //! `t = (e₂·Q)/det` with barycentrics `u = (T·P)/det`, `v = (d·Q)/det`, inside the triangle when
 //! `u ≥ 0, v ≥ 0, u + v ≤ 1`. Both faces are hit.
 
-use super::ray::WideRay;
+use super::ray::{RayLanes, WideRay};
+use crate::math::Vec3x8;
 use glam::Vec3;
 use wide::{CmpGe, CmpGt, CmpLe, CmpLt, f32x8};
 
@@ -72,27 +73,10 @@ impl TrianglePacket {
         Some([v0, v0 + at(&self.e1), v0 + at(&self.e2)])
     }
 
-    /// Lanes hit at `0 < t < t_max` (bit i for lane i), with `(T·P, d·Q, e₂·Q)` and det in every lane. The
-    /// tests run on the numerators with det's sign folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so
-    /// no lane is divided until one is hit.
     #[inline(always)]
     fn test(&self, ray: &WideRay, t_max: f32) -> (u32, [f32x8; 4]) {
-        let [dx, dy, dz] = ray.d;
-        let [e1x, e1y, e1z] = self.e1;
-        let [e2x, e2y, e2z] = self.e2;
-        let (px, py, pz) = (dy.mul_sub(e2z, dz * e2y), dz.mul_sub(e2x, dx * e2z), dx.mul_sub(e2y, dy * e2x));
-        let det = e1x.mul_add(px, e1y.mul_add(py, e1z * pz));
-        let (tx, ty, tz) = (ray.o[0] - self.v0[0], ray.o[1] - self.v0[1], ray.o[2] - self.v0[2]);
-        let (qx, qy, qz) = (ty.mul_sub(e1z, tz * e1y), tz.mul_sub(e1x, tx * e1z), tx.mul_sub(e1y, ty * e1x));
-        let u = tx.mul_add(px, ty.mul_add(py, tz * pz));
-        let v = dx.mul_add(qx, dy.mul_add(qy, dz * qz));
-        let t = e2x.mul_add(qx, e2y.mul_add(qy, e2z * qz));
-        let abs_det = det.abs();
-        let (su, sv, st) = (u.flip_signs(det), v.flip_signs(det), t.flip_signs(det));
-        let zero = f32x8::ZERO;
-        let inside = su.cmp_ge(zero) & sv.cmp_ge(zero) & (su + sv).cmp_le(abs_det);
-        let ahead = st.cmp_gt(zero) & st.cmp_lt(f32x8::splat(t_max) * abs_det);
-        ((inside & ahead & abs_det.cmp_gt(zero)).move_mask() as u32, [t, u, v, det])
+        let (hit, tuvd) = moller_trumbore(&self.v0, &self.e1, &self.e2, &ray.o, &ray.d, t_max);
+        (hit.move_mask() as u32, tuvd)
     }
 
     /// The nearest hit at `0 < t < t_max`.
@@ -118,11 +102,90 @@ impl TrianglePacket {
         Some(LaneHit { lane, t: t[lane], u, v })
     }
 
+    /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
+    /// `active`, all bits set): lane i gets the hit [`TrianglePacket::closest`] finds for ray i, bit for bit, as the same
+    /// (triangle, ray) pairs go through the same arithmetic; only the roles of the lanes are swapped.
+    #[inline(always)]
+    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<LaneHit>; 8] {
+        let o = origin.to_array().map(f32x8::splat);
+        let d = [dirs.x, dirs.y, dirs.z];
+        let mut best_t = f32x8::splat(t_max);
+        let mut hits = [None; 8];
+        for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
+            let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
+            let (hit, [t, u, v, det]) =
+                moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), &o, &d, t_max);
+            let hit = hit & active;
+            if hit.none() {
+                continue;
+            }
+            let inv = f32x8::ONE / det;
+            let t = t * inv;
+            let nearer = hit & t.cmp_lt(best_t);
+            let mut bits = nearer.move_mask() as u32;
+            if bits == 0 {
+                continue;
+            }
+            best_t = nearer.blend(t, best_t);
+            let (t, u, v) = (t.to_array(), (u * inv).to_array(), (v * inv).to_array());
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                hits[i] = Some(LaneHit { lane: k, t: t[i], u: u[i], v: v[i] });
+            }
+        }
+        hits
+    }
+
+    /// The rays of `rays` (bit i for lane i) that hit one of the packet's triangles at `0 < t < t_max`: bit i is
+    /// [`TrianglePacket::any`] for ray i, bit for bit.
+    #[inline(always)]
+    pub fn any_of_rays(&self, rays: &RayLanes, t_max: f32) -> u32 {
+        let mut hit = 0;
+        for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
+            let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
+            let (lanes, _) =
+                moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), &rays.o, &rays.d, t_max);
+            hit |= lanes.move_mask() as u32;
+        }
+        hit
+    }
+
     /// Whether any triangle is hit at `0 < t < t_max`.
     #[inline(always)]
     pub fn any(&self, ray: &WideRay, t_max: f32) -> bool {
         self.test(ray, t_max).0 != 0
     }
+}
+
+/// Möller–Trumbore on eight (triangle, ray) pairs, one per lane. Returns the lanes hit at `0 < t < t_max` (all
+/// bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators with det's sign
+/// folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
+#[inline(always)]
+fn moller_trumbore(
+    v0: &[f32x8; 3],
+    e1: &[f32x8; 3],
+    e2: &[f32x8; 3],
+    o: &[f32x8; 3],
+    d: &[f32x8; 3],
+    t_max: f32,
+) -> (f32x8, [f32x8; 4]) {
+    let [dx, dy, dz] = *d;
+    let [e1x, e1y, e1z] = *e1;
+    let [e2x, e2y, e2z] = *e2;
+    let (px, py, pz) = (dy.mul_sub(e2z, dz * e2y), dz.mul_sub(e2x, dx * e2z), dx.mul_sub(e2y, dy * e2x));
+    let det = e1x.mul_add(px, e1y.mul_add(py, e1z * pz));
+    let (tx, ty, tz) = (o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]);
+    let (qx, qy, qz) = (ty.mul_sub(e1z, tz * e1y), tz.mul_sub(e1x, tx * e1z), tx.mul_sub(e1y, ty * e1x));
+    let u = tx.mul_add(px, ty.mul_add(py, tz * pz));
+    let v = dx.mul_add(qx, dy.mul_add(qy, dz * qz));
+    let t = e2x.mul_add(qx, e2y.mul_add(qy, e2z * qz));
+    let abs_det = det.abs();
+    let (su, sv, st) = (u.flip_signs(det), v.flip_signs(det), t.flip_signs(det));
+    let zero = f32x8::ZERO;
+    let inside = su.cmp_ge(zero) & sv.cmp_ge(zero) & (su + sv).cmp_le(abs_det);
+    let ahead = st.cmp_gt(zero) & st.cmp_lt(f32x8::splat(t_max) * abs_det);
+    (inside & ahead & abs_det.cmp_gt(zero), [t, u, v, det])
 }
 
 #[cfg(test)]

@@ -1,7 +1,9 @@
-//! A ray broadcast to eight SIMD lanes, with what the slab test needs precomputed once per ray.
+//! A ray broadcast to eight SIMD lanes, or eight rays one per lane, with what the slab test needs precomputed
+//! once per ray.
 
+use crate::math::Vec3x8;
 use glam::{Vec3, Vec3A};
-use wide::f32x8;
+use wide::{CmpLt, f32x8};
 
 /// Directions components smaller than this are replaced by it (with their sign), so 1/d stays finite and the
 /// slab test never computes 0·∞.
@@ -32,5 +34,28 @@ impl WideRay {
             near,
             far: near.map(|i| (i + 3) % 6),
         }
+    }
+}
+
+/// Eight rays, one per lane, with [`WideRay`]'s precomputation done lane by lane (the same values bit for bit).
+pub(super) struct RayLanes {
+    pub o: [f32x8; 3],
+    pub d: [f32x8; 3],
+    pub inv_d: [f32x8; 3],
+    /// Per axis, all bits set in the lanes whose ray travels towards −axis (it enters a box by its max plane).
+    pub negative: [f32x8; 3],
+}
+
+impl RayLanes {
+    #[inline]
+    pub fn new(origins: &Vec3x8, dirs: &Vec3x8) -> Self {
+        let d = [dirs.x, dirs.y, dirs.z];
+        let inv_d = d.map(|d| {
+            let tiny = d.abs().cmp_lt(f32x8::splat(MIN_COMPONENT));
+            f32x8::ONE / tiny.blend(f32x8::splat(MIN_COMPONENT).copysign(d), d)
+        });
+        // The sign bit of 1/d, spread over the lane: an arithmetic shift of the bits.
+        let negative = inv_d.map(|inv| bytemuck::cast(bytemuck::cast::<f32x8, wide::i32x8>(inv) >> 31));
+        Self { o: [origins.x, origins.y, origins.z], d, inv_d, negative }
     }
 }

@@ -1,0 +1,146 @@
+//! Light sampling for up to eight samples of one pixel at once, one per SIMD lane. The shadow rays of all lanes
+//! are offset together and walk the BVH together (`Accel::occluded_lanes`). For emitter sampling, the chain of
+//! dependent square roots and divisions each sample needs (hit point, point on the light, distance, ω, density)
+//! also runs in f32x8; what differs per lane in kind (light selection, the material's BRDF) runs in loops over
+//! independent lanes, which the processor overlaps. The other light techniques sample lane by lane. Every lane
+//! computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit for
+//! bit, so a film does not depend on how its samples were grouped.
+
+use super::estimator::{unshadowed, visible_lanes};
+use super::strategy::light::faces;
+use super::{LightTechnique, ShadingPoint, Target};
+use crate::math::{SampleRng, Vec3x8};
+use crate::scene::{EmitterSampler, Hit, Scene};
+use glam::{Vec2, Vec3};
+use wide::{CmpGt, CmpLt, f32x8};
+
+/// Samples per group.
+pub const LANES: usize = 8;
+
+/// `L_e(x, ω_o) + f_r L_i (ω·n) / p(ω)` for up to eight camera rays `dirs` of one pixel and their hits (`None`
+/// for a lane that missed or is unused), with ω from emitter sampling. Each lane's stream `rngs[l]` continues
+/// after the camera's two uniforms. Adds the shadow rays traced to `rays`.
+#[inline]
+pub fn estimate_emitter_lanes(
+    scene: &Scene,
+    emitters: &EmitterSampler,
+    dirs: &Vec3x8,
+    hits: &[Option<Hit>; LANES],
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir.
+    let mut corners = [[Vec3::ZERO; LANES]; 3];
+    let (mut normal, mut barycentric) = ([Vec3::X; LANES], [Vec2::ZERO; LANES]);
+    for (l, hit) in hits.iter().enumerate() {
+        if let Some(hit) = hit {
+            let tri = &scene.triangles[hit.triangle as usize];
+            (0..3).for_each(|k| corners[k][l] = tri.v[k]);
+            (normal[l], barycentric[l]) = (tri.n, Vec2::new(hit.u, hit.v));
+        }
+    }
+    let [a, b, c] = corners.map(|v| Vec3x8::from_lanes(&v));
+    let (u, v) = (f32x8::new(barycentric.map(|b| b.x)), f32x8::new(barycentric.map(|b| b.y)));
+    let p = a + (b - a) * u + (c - a) * v;
+    let wo = -*dirs;
+    let geometric = Vec3x8::from_lanes(&normal);
+    let facing = geometric.dot(wo);
+    let n = Vec3x8::select(facing.cmp_lt(f32x8::ZERO), -geometric, geometric);
+    let front = facing.cmp_gt(f32x8::ZERO).move_mask();
+
+    // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ.
+    let mut light = [[Vec3::ZERO; LANES]; 4]; // v₀, v₁, v₂, n_Δ
+    let (mut p_delta, mut area, mut uv) = ([0.0; LANES], [1.0; LANES], [Vec2::ZERO; LANES]);
+    let mut picked = [u32::MAX; LANES];
+    for (l, hit) in hits.iter().enumerate() {
+        if hit.is_none() {
+            continue;
+        }
+        let Some((t, pd)) = emitters.pick(scene, p.lane(l), rngs[l].uniform()) else { continue };
+        let tri = &scene.triangles[t as usize];
+        if !faces(tri, p.lane(l)) {
+            continue; // the back of a one-sided emitter: L_i = 0
+        }
+        (0..3).for_each(|k| light[k][l] = tri.v[k]);
+        (light[3][l], area[l], p_delta[l], picked[l]) = (tri.n, tri.area, pd, t);
+        uv[l] = rngs[l].uniform_2d();
+    }
+    let [la, lb, lc, ln] = light.map(|v| Vec3x8::from_lanes(&v));
+    // sample_uniform_triangle, then the density p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|), as `emitter::sample` computes them.
+    let su0 = f32x8::new(uv.map(|u| u.x)).sqrt();
+    let b0 = f32x8::ONE - su0;
+    let b1 = f32x8::new(uv.map(|u| u.y)) * su0;
+    let x = la * b0 + lb * b1 + lc * (f32x8::ONE - b0 - b1);
+    let d = x - p;
+    let dist = d.length();
+    let wi = d / dist;
+    let cos_light = ln.dot(-wi);
+    let pdf = f32x8::new(p_delta) * (dist * dist / (f32x8::new(area) * cos_light));
+    let cos = n.dot(wi);
+    let ok = dist.cmp_gt(f32x8::ZERO)
+        & cos_light.cmp_gt(f32x8::ZERO)
+        & pdf.cmp_gt(f32x8::ZERO)
+        & pdf.is_finite()
+        & cos.cmp_gt(f32x8::ZERO);
+    let ok = ok.move_mask();
+
+    let (pdf, cos) = (pdf.to_array(), cos.to_array());
+
+    // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
+    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let mut shadow_rays = 0;
+    for (l, hit) in hits.iter().enumerate() {
+        let Some(hit) = hit else { continue };
+        let material = scene.material_of(hit.triangle);
+        if front & (1 << l) != 0 {
+            emitted[l] = material.emission;
+        }
+        if picked[l] == u32::MAX || ok & (1 << l) == 0 {
+            continue;
+        }
+        let wi = wi.lane(l);
+        let f = material.eval_brdf(n.lane(l), wo.lane(l), wi);
+        let li = scene.emitted(picked[l], -wi);
+        if f != Vec3::ZERO && li != Vec3::ZERO {
+            reflected[l] = f * li * cos[l] / pdf[l];
+            shadow_rays |= 1 << l;
+        }
+    }
+    let visible = visible_lanes(scene, p, n, x, ln, shadow_rays, rays);
+    std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+}
+
+/// [`estimate_emitter_lanes`] for any light technique, with the sampling and the BRDF lane by lane: only the
+/// shadow rays go together. Each lane's stream
+/// `rngs[l]` continues after the camera's two uniforms. Adds the shadow rays traced to `rays`.
+#[inline]
+pub fn estimate_light_lanes(
+    scene: &Scene,
+    emitters: &EmitterSampler,
+    technique: LightTechnique,
+    dirs: &Vec3x8,
+    hits: &[Option<Hit>; LANES],
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal.
+    let mut ends = [[Vec3::ZERO; LANES]; 4];
+    let mut shadow_rays = 0;
+    for (l, hit) in hits.iter().enumerate() {
+        let Some(hit) = hit else { continue };
+        let tri = &scene.triangles[hit.triangle as usize];
+        let wo = -dirs.lane(l);
+        let sp = ShadingPoint::new(scene.hit_point(hit), tri.n, wo, scene.material_of(hit.triangle));
+        emitted[l] = scene.emitted(hit.triangle, wo);
+        let Some(s) = technique.sample(&sp, scene, emitters, &mut rngs[l]) else { continue };
+        let Target::Emitter { triangle, point } = s.target else { continue };
+        let Some((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
+        reflected[l] = value / s.pdf;
+        (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
+        shadow_rays |= 1 << l;
+    }
+    let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
+    let visible = visible_lanes(scene, p, n, x, n_x, shadow_rays, rays);
+    std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+}
