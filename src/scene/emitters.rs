@@ -84,12 +84,18 @@ impl EmitterSampler {
 
     /// Picks an emitter triangle Δ for the shading point p with one uniform; returns it and p_Δ. `None` where
     /// the selection gives every triangle weight 0 at p.
-    #[inline]
+    #[inline(always)]
     pub fn pick(&self, scene: &Scene, p: Vec3, u: f32) -> Option<(u32, f32)> {
         if self.selection != LightSelection::Contribution {
             let (slot, p_delta) = self.distribution.sample(u);
             return Some((self.triangles[slot], p_delta));
         }
+        self.pick_by_contribution(scene, p, u)
+    }
+
+    /// [`EmitterSampler::pick`] for [`LightSelection::Contribution`]: the weights are computed at p.
+    #[inline(never)]
+    fn pick_by_contribution(&self, scene: &Scene, p: Vec3, u: f32) -> Option<(u32, f32)> {
         let total: f64 = self.triangles.iter().map(|&t| contribution(scene, t, p)).sum();
         if !(total > 0.0 && total.is_finite()) {
             return None;
