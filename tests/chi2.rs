@@ -4,15 +4,15 @@
 
 mod common;
 
-use common::chi2::{SphereBins, per_test_level, triangle_test};
+use common::chi2::{SphereBins, discrete_test, per_test_level, triangle_test};
 use glam::{Vec2, Vec3};
 use illumlab::sampling::{
-    cosine_hemisphere_pdf, phong_lobe_pdf, sample_cosine_hemisphere, sample_phong_lobe, sample_uniform_hemisphere,
+    DiscreteDistribution, cosine_hemisphere_pdf, phong_lobe_pdf, sample_cosine_hemisphere, sample_phong_lobe, sample_uniform_hemisphere,
     sample_uniform_triangle, uniform_hemisphere_pdf, uniform_triangle_pdf_area,
 };
 use illumlab::scene::Material;
 
-const TESTS_IN_FILE: usize = 9;
+const TESTS_IN_FILE: usize = 10;
 const SAMPLES: u64 = 1_000_000;
 
 fn check(name: &str, o: common::chi2::Outcome) {
@@ -109,4 +109,15 @@ fn uniform_triangle_point() {
         uniform_triangle_pdf_area(area) as f64
     });
     check("uniform point on a triangle", o);
+}
+
+#[test]
+fn light_selection_alias_table() {
+    // 600 emitter triangles (Veach's spheres have hundreds) whose weights span six orders of magnitude, with zeros.
+    let weights: Vec<f64> =
+        (0..600).map(|i| if i % 7 == 3 { 0.0 } else { 10f64.powf((i as f64 * 0.618).fract() * 6.0 - 3.0) }).collect();
+    let total: f64 = weights.iter().sum();
+    let probabilities: Vec<f64> = weights.iter().map(|w| w / total).collect();
+    let d = DiscreteDistribution::new(&weights).unwrap();
+    check("light selection p_Δ (alias table)", discrete_test(&probabilities, SAMPLES, 10, &|u| d.sample(u)));
 }

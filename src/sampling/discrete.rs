@@ -1,9 +1,13 @@
 //! A discrete distribution over indices, proportional to non-negative weights: the p_Δ of emitter selection.
 
-/// Piecewise-constant CDF with binary-search sampling. Entries of weight zero are never sampled.
+/// Walker's alias method in Vose's construction ("A Linear Algorithm for Generating Random Numbers with a Given
+/// Distribution", 1991): every index owns a bucket of width 1/n; bucket i returns i with probability q_i and its
+/// alias a_i otherwise, so that `Pr(i) = (q_i + Σ_{j: a_j = i} (1 − q_j)) / n = pmf(i)`. Sampling costs O(1)
+/// whatever the number of emitter triangles. Entries of weight zero are never sampled.
 #[derive(Clone, Debug, Default)]
 pub struct DiscreteDistribution {
-    cdf: Vec<f64>,
+    /// Per bucket: q_i, and the alias a_i.
+    buckets: Vec<(f64, u32)>,
     pmf: Vec<f32>,
 }
 
@@ -15,29 +19,37 @@ impl DiscreteDistribution {
         if !(total > 0.0 && total.is_finite()) {
             return None;
         }
-        let mut cdf = Vec::with_capacity(weights.len() + 1);
-        let mut acc = 0.0;
-        cdf.push(0.0);
-        for &w in weights {
-            acc += clean(w);
-            cdf.push(acc / total);
+        let n = weights.len();
+        // Each bucket's share of its own index, in units of 1/n: below 1 it needs an alias to fill up.
+        let mut share: Vec<f64> = weights.iter().map(|&w| clean(w) / total * n as f64).collect();
+        let (mut small, mut large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| share[i] < 1.0);
+        let mut buckets = vec![(1.0, 0u32); n];
+        while let (Some(&s), Some(&l)) = (small.last(), large.last()) {
+            small.pop();
+            buckets[s] = (share[s], l as u32);
+            share[l] -= 1.0 - share[s];
+            if share[l] < 1.0 {
+                large.pop();
+                small.push(l);
+            }
         }
-        *cdf.last_mut()? = 1.0;
+        // What rounding leaves over is (to rounding) full; a bucket of weight zero still points elsewhere.
+        let heaviest = (0..n).max_by(|&a, &b| clean(weights[a]).total_cmp(&clean(weights[b])))? as u32;
+        for i in small.into_iter().chain(large) {
+            buckets[i] = if clean(weights[i]) > 0.0 { (1.0, 0) } else { (0.0, heaviest) };
+        }
         let pmf = weights.iter().map(|&w| (clean(w) / total) as f32).collect();
-        Some(Self { cdf, pmf })
+        Some(Self { buckets, pmf })
     }
 
-    /// Picks index i with probability `pmf(i)`; returns it and its probability.
+    /// Picks index i with probability `pmf(i)`; returns it and its probability. The bucket and the choice in it
+    /// come from `u·n` in f64, which is exact for u with 24 bits.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
-        let u = u as f64;
-        // The number of CDF entries after the leading 0 that are ≤ u; a branch-free count for a few entries.
-        let below = if self.cdf.len() <= 17 {
-            self.cdf[1..].iter().filter(|&&c| c <= u).count()
-        } else {
-            self.cdf.partition_point(|&c| c <= u) - 1
-        };
-        let i = below.min(self.pmf.len() - 1);
+        let x = u as f64 * self.buckets.len() as f64;
+        let bucket = (x as usize).min(self.buckets.len() - 1);
+        let (q, alias) = self.buckets[bucket];
+        let i = if x - (bucket as f64) < q { bucket } else { alias as usize };
         (i, self.pmf[i])
     }
 
@@ -59,9 +71,30 @@ mod tests {
             assert!(i == 1 || i == 3);
             assert!(p > 0.0);
         }
-        assert_eq!(d.sample(0.0).0, 1);
-        assert_eq!(d.sample(0.999_999_94).0, 3);
+        assert!(matches!(d.sample(0.999_999_94).0, 1 | 3));
         assert!((d.pmf(3) - 0.75).abs() < 1e-7);
+    }
+
+    /// Over every u = k/2²⁴ (all the values `SampleRng::uniform` gives), each index is picked with its pmf up to
+    /// 2⁻²³ per bucket (where a bucket starts, and where its own index gives way to the alias, fall on that grid):
+    /// the table reproduces the weights, not just in expectation.
+    #[test]
+    fn every_uniform_picks_indices_in_proportion_to_their_weights() {
+        let weights: Vec<f64> = (0..37).map(|i| if i % 5 == 0 { 0.0 } else { (i as f64 * 0.37).exp() % 7.0 }).collect();
+        let d = DiscreteDistribution::new(&weights).unwrap();
+        let mut counts = vec![0u64; weights.len()];
+        let steps = 1u32 << 24;
+        for k in 0..steps {
+            let (i, p) = d.sample(k as f32 / steps as f32);
+            assert_eq!(p, d.pmf(i));
+            counts[i] += 1;
+        }
+        for (i, &c) in counts.iter().enumerate() {
+            let share = c as f64 / steps as f64;
+            let tolerance = 2f64.powi(-23) * weights.len() as f64;
+            assert!((share - d.pmf(i) as f64).abs() <= tolerance, "index {i}: {share} vs {}", d.pmf(i));
+            assert_eq!(c == 0, weights[i] == 0.0, "index {i}");
+        }
     }
 
     #[test]

@@ -162,6 +162,20 @@ pub fn triangle_test(
     Outcome { statistic, dof, p_value: p_value(statistic, dof), integral }
 }
 
+/// A discrete sampler of indices against its probabilities: `sample(u)` returns an index and the probability it
+/// claims for it, which must be `probabilities[i]` (to f32 rounding).
+pub fn discrete_test(probabilities: &[f64], samples: u64, seed: u64, sample: &dyn Fn(f32) -> (usize, f32)) -> Outcome {
+    let mut observed = vec![0.0; probabilities.len()];
+    for k in 0..samples {
+        let mut rng = SampleRng::new(seed, k, 0);
+        let (i, p) = sample(rng.uniform());
+        assert!((p as f64 - probabilities[i]).abs() <= 1e-6 * probabilities[i], "index {i} claims p = {p}");
+        observed[i] += 1.0;
+    }
+    let (statistic, dof) = chi_square(&observed, probabilities, samples as f64);
+    Outcome { statistic, dof, p_value: p_value(statistic, dof), integral: probabilities.iter().sum() }
+}
+
 /// Pearson's statistic after pooling every cell expecting fewer than 5 samples into one.
 fn chi_square(observed: &[f64], expected_fraction: &[f64], n: f64) -> (f64, usize) {
     let (mut stat, mut cells) = (0.0, 0usize);
