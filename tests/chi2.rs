@@ -7,8 +7,8 @@ mod common;
 use common::chi2::{SphereBins, discrete_test, per_test_level, triangle_test};
 use glam::{Vec2, Vec3};
 use illumlab::sampling::{
-    DiscreteDistribution, cosine_hemisphere_pdf, phong_lobe_pdf, sample_cosine_hemisphere, sample_phong_lobe, sample_uniform_hemisphere,
-    sample_uniform_triangle, uniform_hemisphere_pdf, uniform_triangle_pdf_area,
+    DiscreteDistribution, cosine_hemisphere_pdf, phong_lobe_pdf, sample_cosine_hemisphere, sample_phong_lobe,
+    sample_uniform_hemisphere, sample_uniform_triangle, uniform_hemisphere_pdf, uniform_triangle_pdf_area,
 };
 use illumlab::scene::Material;
 
