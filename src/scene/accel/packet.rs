@@ -102,6 +102,14 @@ impl TrianglePacket {
         Some(LaneHit { lane, t: t[lane], u, v })
     }
 
+    /// The triangle in lane `k` against eight rays `o + t·d`, one per lane: [`moller_trumbore`] with the roles of
+    /// the lanes swapped.
+    #[inline(always)]
+    fn test_rays(&self, k: usize, o: &[f32x8; 3], d: &[f32x8; 3], t_max: f32) -> (f32x8, [f32x8; 4]) {
+        let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
+        moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), o, d, t_max)
+    }
+
     /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
     /// `active`, all bits set): lane i gets the hit [`TrianglePacket::closest`] finds for ray i, bit for bit, as the same
     /// (triangle, ray) pairs go through the same arithmetic; only the roles of the lanes are swapped.
@@ -112,9 +120,7 @@ impl TrianglePacket {
         let mut best_t = f32x8::splat(t_max);
         let mut hits = [None; 8];
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
-            let (hit, [t, u, v, det]) =
-                moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), &o, &d, t_max);
+            let (hit, [t, u, v, det]) = self.test_rays(k, &o, &d, t_max);
             let hit = hit & active;
             if hit.none() {
                 continue;
@@ -143,10 +149,7 @@ impl TrianglePacket {
     pub fn any_of_rays(&self, rays: &RayLanes, t_max: f32) -> u32 {
         let mut hit = 0;
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
-            let (lanes, _) =
-                moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), &rays.o, &rays.d, t_max);
-            hit |= lanes.move_mask() as u32;
+            hit |= self.test_rays(k, &rays.o, &rays.d, t_max).0.move_mask() as u32;
         }
         hit
     }
