@@ -7,7 +7,6 @@
 //! bit, so a film does not depend on how its samples were grouped.
 
 use super::estimator::{unshadowed, visible_lanes};
-use super::strategy::light::faces;
 use super::{LightTechnique, ShadingPoint, Target};
 use crate::math::{SampleRng, Vec3x8};
 use crate::scene::{EmitterSampler, Hit, Scene};
@@ -58,9 +57,8 @@ pub fn estimate_emitter_lanes(
         }
         let Some((t, pd)) = emitters.pick(scene, p.lane(l), rngs[l].uniform()) else { continue };
         let tri = &scene.triangles[t as usize];
-        if !faces(tri, p.lane(l)) {
-            continue; // the back of a one-sided emitter: L_i = 0
-        }
+        // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not has drawn two uniforms
+        // more than the one-sample estimator, which no later step of its sample reads.
         (0..3).for_each(|k| light[k][l] = tri.v[k]);
         (light[3][l], area[l], p_delta[l], picked[l]) = (tri.n, tri.area, pd, t);
         uv[l] = rngs[l].uniform_2d();
@@ -77,7 +75,10 @@ pub fn estimate_emitter_lanes(
     let cos_light = ln.dot(-wi);
     let pdf = f32x8::new(p_delta) * (dist * dist / (f32x8::new(area) * cos_light));
     let cos = n.dot(wi);
-    let ok = dist.cmp_gt(f32x8::ZERO)
+    // `faces`: p on the emitting side of Δ's plane (else L_i = 0, the back of a one-sided emitter).
+    let faces = ln.dot(p - la).cmp_gt(f32x8::ZERO);
+    let ok = faces
+        & dist.cmp_gt(f32x8::ZERO)
         & cos_light.cmp_gt(f32x8::ZERO)
         & pdf.cmp_gt(f32x8::ZERO)
         & pdf.is_finite()

@@ -49,7 +49,8 @@ impl DiscreteDistribution {
         let x = u as f64 * self.buckets.len() as f64;
         let bucket = (x as usize).min(self.buckets.len() - 1);
         let (q, alias) = self.buckets[bucket];
-        let i = if x - (bucket as f64) < q { bucket } else { alias as usize };
+        // Which of the two a bucket gives is a coin flip for the branch predictor: select without a branch.
+        let i = std::hint::select_unpredictable(x - (bucket as f64) < q, bucket, alias as usize);
         (i, self.pmf[i])
     }
 

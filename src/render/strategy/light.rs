@@ -90,7 +90,7 @@ impl LightTechnique {
 
 /// Whether p is on the emitting side of the triangle's plane.
 #[inline]
-pub(crate) fn faces(tri: &Triangle, p: Vec3) -> bool {
+fn faces(tri: &Triangle, p: Vec3) -> bool {
     tri.n.dot(p - tri.v[0]) > 0.0
 }
 
