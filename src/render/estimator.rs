@@ -123,6 +123,9 @@ pub(super) fn visible_lanes(
     active: u32,
     rays: &mut u64,
 ) -> u32 {
+    if active == 0 {
+        return 0; // a group whose samples all missed, saw only a light, or were rejected
+    }
     *rays += active.count_ones() as u64;
     let from = offset_ray_origins(p, n);
     let to = offset_ray_origins(x, n_x);

@@ -112,8 +112,8 @@ pub fn estimate_emitter_lanes(
 }
 
 /// [`estimate_emitter_lanes`] for any light technique, with the sampling and the BRDF lane by lane: only the
-/// shadow rays go together. Each lane's stream
-/// `rngs[l]` continues after the camera's two uniforms. Adds the shadow rays traced to `rays`.
+/// shadow rays go together. Each lane's stream `rngs[l]` continues after the camera's two uniforms. Adds the
+/// shadow rays traced to `rays`.
 #[inline]
 pub fn estimate_light_lanes(
     scene: &Scene,
