@@ -162,7 +162,8 @@ mod tests {
 
     /// Eight rays walking the BVH together, one per lane, answer as each does alone, bit for bit: bundles from
     /// nearby origins towards one region (as a pixel's shadow rays) and bundles of unrelated rays, with some
-    /// lanes inactive, on soups of every size.
+    /// lanes inactive, on soups of every size (where fewer than five rays enter a subtree, they walk it alone,
+    /// interleaved).
     #[test]
     fn eight_rays_together_answer_as_each_alone() {
         let mut occluded = 0;

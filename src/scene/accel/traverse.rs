@@ -2,7 +2,7 @@
 //! nearest first and skips any entered beyond the best hit so far; the any-hit query stops at the first triangle
 //! in range. Eight any-hit rays can also walk the tree together, one per lane (e.g. the shadow rays of eight
 //! samples of one pixel): each node's children are tested against all of them at once, and a ray drops out
-//! when it is found occluded.
+//! when it is found occluded; where too few of them enter a subtree, they walk on alone but interleaved.
 
 use super::build::MAX_DEPTH;
 use super::node::Child;
@@ -15,7 +15,7 @@ use glam::Vec3;
 /// Each level pushes at most seven children (the eighth is visited at once).
 pub(super) const STACK: usize = 7 * MAX_DEPTH + 8;
 
-/// Rays walk a subtree together while at least this many of them enter it; fewer go on one by one, since a
+/// Rays walk a subtree together while at least this many of them enter it; fewer go on alone, since a
 /// node costs the bundle eight box tests whatever the number of rays still in it (Benthin et al., "Combining
 /// Single and Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture", 2012).
 const PACKET_MIN_RAYS: u32 = 5;
@@ -85,29 +85,37 @@ impl Accel {
     /// [`Accel::occluded`] within the subtree `start`.
     #[inline]
     fn occluded_below(&self, start: Child, ray: &WideRay, t_max: f32) -> bool {
-        let mut stack = ArrayVec::<Child, STACK>::new();
+        let mut stack = AnyHitStack::new();
         stack.push(start);
+        while !stack.is_empty() {
+            if self.occlusion_step(&mut stack, ray, t_max) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// One step of an any-hit walk: takes the subtree on top of `stack` and tests a leaf's triangles or a node's
+    /// children, testing the leaves among them at once and pushing the nodes (the order does not matter for any
+    /// hit). True when a triangle in range was found; false also for an empty stack.
+    #[inline(always)]
+    fn occlusion_step(&self, stack: &mut AnyHitStack, ray: &WideRay, t_max: f32) -> bool {
         let leaf_hit = |leaf: Child| {
             self.packets[leaf.first as usize..(leaf.first + leaf.packets) as usize].iter().any(|p| p.any(ray, t_max))
         };
-        while let Some(current) = stack.pop() {
-            if current.is_leaf() {
-                if leaf_hit(current) {
-                    return true;
-                }
-                continue;
-            }
-            // Leaves are tested at once, nodes wait on the stack: the order does not matter for any hit.
-            let node = &self.nodes[current.first as usize];
-            let mut mask = node.intersect(ray, t_max).0;
-            while mask != 0 {
-                let child = node.children[mask.trailing_zeros() as usize];
-                mask &= mask - 1;
-                if !child.is_leaf() {
-                    stack.push(child);
-                } else if leaf_hit(child) {
-                    return true;
-                }
+        let Some(current) = stack.pop() else { return false };
+        if current.is_leaf() {
+            return leaf_hit(current);
+        }
+        let node = &self.nodes[current.first as usize];
+        let mut mask = node.intersect(ray, t_max).0;
+        while mask != 0 {
+            let child = node.children[mask.trailing_zeros() as usize];
+            mask &= mask - 1;
+            if !child.is_leaf() {
+                stack.push(child);
+            } else if leaf_hit(child) {
+                return true;
             }
         }
         false
@@ -115,19 +123,46 @@ impl Accel {
 
     /// [`Accel::occluded`] for eight rays `origins + t·dirs`, one per lane, those in `active` (bit i for lane i);
     /// returns the occluded ones. Ray i visits the leaves its own slab tests admit and meets their triangles
-    /// through the same arithmetic as alone, so its answer is [`Accel::occluded`]'s, bit for bit. The rays
-    /// share the walk, so the tests of a node's children for all of them are independent and overlap, until
-    /// fewer than [`PACKET_MIN_RAYS`] remain in a subtree.
+    /// through the same arithmetic as alone, so its answer is [`Accel::occluded`]'s, bit for bit.
+    ///
+    /// The rays share the walk while at least [`PACKET_MIN_RAYS`] of them enter a subtree: the tests of a node's
+    /// children for all of them are independent and overlap. A subtree fewer rays enter is set aside on the
+    /// stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
+    /// ([`Accel::walk_alone`]): before the shared walk goes on with one of them (it may be occluded by then), when
+    /// one has [`SET_ASIDE`] subtrees set aside, and at the end. Where the rays part at the root (lights in
+    /// different places), they all walk alone together.
     #[inline]
     pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32) -> u32 {
         let Some(root) = self.root else { return 0 };
+        let mut alone: [AnyHitStack; 8] = Default::default();
+        if active.count_ones() < PACKET_MIN_RAYS {
+            for_each_lane(active, |l| alone[l].push(root));
+            return self.walk_alone(&mut alone, active, origins, dirs, t_max);
+        }
         let rays = RayLanes::new(origins, dirs);
-        let mut occluded = 0;
+        // The lanes with subtrees set aside, and those with no room left to set one more aside.
+        let (mut occluded, mut set_aside, mut full) = (0, 0, 0);
         let mut stack = ArrayVec::<(Child, u32), { STACK + MAX_DEPTH }>::new();
         stack.push((root, active));
         while let Some((current, lanes)) = stack.pop() {
             let mut lanes = lanes & !occluded;
+            let few = lanes.count_ones() < PACKET_MIN_RAYS;
+            // Rays about to go on together, or to set one more subtree aside, first walk alone.
+            let walk_first = if few { full } else { set_aside };
+            if lanes & walk_first != 0 {
+                occluded |= self.walk_alone(&mut alone, set_aside, origins, dirs, t_max);
+                (set_aside, full) = (0, 0);
+                lanes &= !occluded;
+            }
             if lanes == 0 {
+                continue;
+            }
+            if few {
+                for_each_lane(lanes, |l| {
+                    alone[l].push(current);
+                    full |= ((alone[l].len() == SET_ASIDE) as u32) << l;
+                });
+                set_aside |= lanes;
                 continue;
             }
             if current.is_leaf() {
@@ -140,17 +175,7 @@ impl Accel {
                     }
                 }
                 if occluded == active {
-                    break;
-                }
-                continue;
-            }
-            if lanes.count_ones() < PACKET_MIN_RAYS {
-                // Too few rays left here to fill the lanes: each goes on alone.
-                while lanes != 0 {
-                    let l = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    let ray = WideRay::new(origins.lane(l), dirs.lane(l));
-                    occluded |= (self.occluded_below(current, &ray, t_max) as u32) << l;
+                    return occluded;
                 }
                 continue;
             }
@@ -165,6 +190,51 @@ impl Accel {
                 }
             }
         }
+        occluded | self.walk_alone(&mut alone, set_aside, origins, dirs, t_max)
+    }
+
+    /// The rays of `lanes` (bit i for lane i) walk the subtrees on their stacks in `stacks`, each alone, one step
+    /// of each in turn: the walks are independent, so the dependent chain of each (node, box test, child)
+    /// overlaps the others' instead of waiting alone. Returns the occluded ones; leaves their stacks empty.
+    #[inline]
+    fn walk_alone(
+        &self,
+        stacks: &mut [AnyHitStack; 8],
+        lanes: u32,
+        origins: &Vec3x8,
+        dirs: &Vec3x8,
+        t_max: f32,
+    ) -> u32 {
+        let mut rays: [Option<WideRay>; 8] = Default::default();
+        for_each_lane(lanes, |l| rays[l] = Some(WideRay::new(origins.lane(l), dirs.lane(l))));
+        let (mut walking, mut occluded) = (lanes, 0);
+        while walking != 0 {
+            for_each_lane(walking, |l| {
+                let Some(ray) = &rays[l] else { return };
+                if self.occlusion_step(&mut stacks[l], ray, t_max) {
+                    occluded |= 1 << l;
+                    stacks[l].clear();
+                }
+                if stacks[l].is_empty() {
+                    walking &= !(1 << l);
+                }
+            });
+        }
         occluded
+    }
+}
+
+/// Subtrees set aside per ray in [`Accel::occluded_lanes`] before the rays walk alone.
+const SET_ASIDE: usize = 8;
+
+/// The stack of a ray's any-hit walk: room for the subtrees set aside and for a walk from one of them.
+type AnyHitStack = ArrayVec<Child, { SET_ASIDE + STACK }>;
+
+/// Calls `f` with each set bit's index, lowest first.
+#[inline(always)]
+fn for_each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
+    while bits != 0 {
+        f(bits.trailing_zeros() as usize);
+        bits &= bits - 1;
     }
 }
