@@ -205,6 +205,9 @@ impl Accel {
         dirs: &Vec3x8,
         t_max: f32,
     ) -> u32 {
+        if lanes == 0 {
+            return 0; // nothing set aside: the common end of a coherent bundle's walk
+        }
         let mut rays: [Option<WideRay>; 8] = Default::default();
         for_each_lane(lanes, |l| rays[l] = Some(WideRay::new(origins.lane(l), dirs.lane(l))));
         let (mut walking, mut occluded) = (lanes, 0);
