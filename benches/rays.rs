@@ -9,7 +9,7 @@
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use illumlab::math::{SampleRng, Vec3x8, offset_ray_origin};
-use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
+use illumlab::render::{Film, RenderSettings, Renderer, SEGMENT_END, Strategy};
 use illumlab::sampling::sample_uniform_triangle;
 use illumlab::scene::{EmitterSampler, LightSelection, Scene, load_scene};
 use std::hint::black_box;
@@ -19,7 +19,8 @@ const PER_PIXEL: usize = 8;
 
 struct Workload {
     primary: Vec<(Vec3, Vec3)>,
-    /// Segments `o + t·d`, 0 < t < 0.999, from a hit point to a point on a light.
+    /// Segments `o + t·d`, 0 < t < [`SEGMENT_END`], from a hit point to a point on a light, as the integrator
+    /// traces them (both ends moved off their surfaces).
     shadow: Vec<(Vec3, Vec3)>,
     /// The same segments grouped by pixel: origins, directions and the lanes in use.
     shadow_lanes: Vec<(Vec3x8, Vec3x8, u32)>,
@@ -40,15 +41,25 @@ fn workload(scene: &Scene) -> Workload {
             let dir = basis.direction(x, y, rng.uniform_2d());
             work.primary.push((basis.eye(), dir));
             let Some(hit) = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY) else { continue };
+            // The shadow ray `emitter` traces for this sample, if any: it skips a sample whose point on the
+            // light is behind the light or below the surface, or whose f_r is 0, since it contributes nothing.
             let tri = &scene.triangles[hit.triangle as usize];
             let n = if tri.n.dot(dir) < 0.0 { tri.n } else { -tri.n };
-            let p = offset_ray_origin(basis.eye() + dir * hit.t, n);
+            let p = scene.hit_point(&hit);
             let Some((t, _)) = emitters.pick(scene, p, rng.uniform()) else { continue };
-            let [a, b, c] = scene.triangles[t as usize].v;
-            let d = sample_uniform_triangle(rng.uniform_2d(), a, b, c) - p;
+            let light = &scene.triangles[t as usize];
+            let [a, b, c] = light.v;
+            let x = sample_uniform_triangle(rng.uniform_2d(), a, b, c);
+            let wi = (x - p).normalize();
+            let f = scene.materials[tri.material as usize].eval_brdf(n, -dir, wi);
+            if !(light.n.dot(p - a) > 0.0 && light.n.dot(-wi) > 0.0 && n.dot(wi) > 0.0 && f != Vec3::ZERO) {
+                continue;
+            }
+            let from = offset_ray_origin(p, n);
+            let d = offset_ray_origin(x, light.n) - from;
             let l = lanes.2.count_ones() as usize;
-            (lanes.0[l], lanes.1[l], lanes.2) = (p, d, lanes.2 | 1 << l);
-            work.shadow.push((p, d));
+            (lanes.0[l], lanes.1[l], lanes.2) = (from, d, lanes.2 | 1 << l);
+            work.shadow.push((from, d));
         }
         if lanes.2 != 0 {
             work.shadow_lanes.push((Vec3x8::from_lanes(&lanes.0), Vec3x8::from_lanes(&lanes.1), lanes.2));
@@ -77,7 +88,7 @@ fn rays(c: &mut Criterion) {
             b.iter(|| {
                 let mut blocked = 0u32;
                 for &(o, d) in &work.shadow {
-                    blocked += scene.accel().occluded(o, d, 0.999) as u32;
+                    blocked += scene.accel().occluded(o, d, SEGMENT_END) as u32;
                 }
                 black_box(blocked)
             })
@@ -86,7 +97,7 @@ fn rays(c: &mut Criterion) {
             b.iter(|| {
                 let mut blocked = 0u32;
                 for (o, d, active) in &work.shadow_lanes {
-                    blocked += scene.accel().occluded_lanes(o, d, 0.999, *active).count_ones();
+                    blocked += scene.accel().occluded_lanes(o, d, SEGMENT_END, *active).count_ones();
                 }
                 black_box(blocked)
             })

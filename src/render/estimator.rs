@@ -133,4 +133,4 @@ pub(super) fn visible_lanes(
 }
 
 /// Shadow rays run along `from + t·(to − from)` for 0 < t < 1 − 10⁻⁶ (the direction is not a unit vector).
-const SEGMENT_END: f32 = 1.0 - 1e-6;
+pub const SEGMENT_END: f32 = 1.0 - 1e-6;

@@ -46,12 +46,18 @@ impl DiscreteDistribution {
     /// come from `u·n` in f64, which is exact for u with 24 bits.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
+        let i = self.sample_index(u);
+        (i, self.pmf[i])
+    }
+
+    /// [`DiscreteDistribution::sample`] without the probability.
+    #[inline]
+    pub fn sample_index(&self, u: f32) -> usize {
         let x = u as f64 * self.buckets.len() as f64;
         let bucket = (x as usize).min(self.buckets.len() - 1);
         let (q, alias) = self.buckets[bucket];
         // Which of the two a bucket gives is a coin flip for the branch predictor: select without a branch.
-        let i = std::hint::select_unpredictable(x - (bucket as f64) < q, bucket, alias as usize);
-        (i, self.pmf[i])
+        std::hint::select_unpredictable(x - (bucket as f64) < q, bucket, alias as usize)
     }
 
     #[inline]

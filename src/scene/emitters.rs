@@ -48,6 +48,24 @@ pub struct EmitterSampler {
     triangles: Vec<u32>,
     /// Slot of each scene triangle (u32::MAX where it does not emit).
     slot_of: Vec<u32>,
+    /// What light sampling reads of each slot's triangle, with its p_Δ, for the selections that do not depend on
+    /// the shading point (empty for the others).
+    records: Vec<EmitterTriangle>,
+}
+
+/// An emitter triangle as light sampling reads it, in one cache line with its p_Δ: picking one costs one load
+/// after the alias table's, where going through the slot's triangle index and the scene's triangle list costs
+/// two more, each waiting on the one before.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct EmitterTriangle {
+    pub v: [Vec3; 3],
+    /// The unit normal n_Δ.
+    pub n: Vec3,
+    /// A_Δ.
+    pub area: f32,
+    pub p_delta: f32,
+    pub material: u32,
 }
 
 impl EmitterSampler {
@@ -79,7 +97,27 @@ impl EmitterSampler {
         for (slot, &t) in scene.emitters.iter().enumerate() {
             slot_of[t as usize] = slot as u32;
         }
-        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of })
+        let records = if selection == LightSelection::Contribution {
+            Vec::new()
+        } else {
+            let record = |(slot, &t): (usize, &u32)| {
+                let tri = &scene.triangles[t as usize];
+                let p_delta = distribution.pmf(slot);
+                EmitterTriangle { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material }
+            };
+            scene.emitters.iter().enumerate().map(record).collect()
+        };
+        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records })
+    }
+
+    /// What [`EmitterSampler::pick`] picks for the same u, as light sampling reads it, for the selections that
+    /// do not depend on the shading point (`None` for [`LightSelection::Contribution`]).
+    #[inline(always)]
+    pub fn pick_fixed(&self, u: f32) -> Option<&EmitterTriangle> {
+        if self.records.is_empty() {
+            return None;
+        }
+        Some(&self.records[self.distribution.sample_index(u)])
     }
 
     /// Picks an emitter triangle Δ for the shading point p with one uniform; returns it and p_Δ. `None` where
@@ -143,4 +181,28 @@ fn contribution(scene: &Scene, t: u32, p: Vec3) -> f64 {
     let solid_angle = (tri.area as f64 * cos / (d2 * d2.sqrt())).min(std::f64::consts::TAU);
     let l = luminance(scene.materials[tri.material as usize].emission).max(0.0) as f64;
     if solid_angle.is_finite() { solid_angle * l } else { std::f64::consts::TAU * l }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::load_scene;
+
+    #[test]
+    fn records_hold_what_pick_picks() {
+        let scene = load_scene("veach-mis").unwrap();
+        for selection in LightSelection::ALL {
+            let sampler = EmitterSampler::new(&scene, selection).unwrap();
+            for i in 0..10_000 {
+                let u = i as f32 / 10_000.0;
+                let Some(e) = sampler.pick_fixed(u) else {
+                    assert_eq!(selection, LightSelection::Contribution);
+                    continue;
+                };
+                let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
+                let tri = &scene.triangles[t as usize];
+                assert_eq!((e.v, e.n, e.area, e.p_delta, e.material), (tri.v, tri.n, tri.area, p_delta, tri.material));
+            }
+        }
+    }
 }

@@ -15,7 +15,7 @@ pub use accel::{Accel, ConeCandidates, Hit};
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
-pub use emitters::{EmitterSampler, LightSelection};
+pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection};
 pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
 pub use load::{load_scene, load_scene_file};
