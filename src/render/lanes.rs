@@ -50,8 +50,8 @@ pub fn estimate_emitter_lanes(
     // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ.
     let mut light = [[Vec3::ZERO; LANES]; 4]; // v₀, v₁, v₂, n_Δ
     let (mut p_delta, mut area, mut uv) = ([0.0; LANES], [1.0; LANES], [Vec2::ZERO; LANES]);
-    // The material of the picked triangle (u32::MAX for none).
-    let mut picked = [u32::MAX; LANES];
+    // The picked triangle's material (u32::MAX for none).
+    let mut light_material = [u32::MAX; LANES];
     for (l, hit) in hits.iter().enumerate() {
         if hit.is_none() {
             continue;
@@ -68,7 +68,7 @@ pub fn estimate_emitter_lanes(
         // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not has drawn two uniforms
         // more than the one-sample estimator, which no later step of its sample reads.
         (0..3).for_each(|k| light[k][l] = v[k]);
-        (light[3][l], area[l], p_delta[l], picked[l]) = (n_delta, a, pd, material);
+        (light[3][l], area[l], p_delta[l], light_material[l]) = (n_delta, a, pd, material);
         uv[l] = rngs[l].uniform_2d();
     }
     let [la, lb, lc, ln] = light.map(|v| Vec3x8::from_lanes(&v));
@@ -104,13 +104,13 @@ pub fn estimate_emitter_lanes(
         if front & (1 << l) != 0 {
             emitted[l] = material.emission;
         }
-        if picked[l] == u32::MAX || ok & (1 << l) == 0 {
+        if light_material[l] == u32::MAX || ok & (1 << l) == 0 {
             continue;
         }
         let wi = wi.lane(l);
         let f = material.eval_brdf(n.lane(l), wo.lane(l), wi);
         // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`.
-        let li = scene.materials[picked[l] as usize].emission;
+        let li = scene.materials[light_material[l] as usize].emission;
         if f != Vec3::ZERO && li != Vec3::ZERO {
             reflected[l] = f * li * cos[l] / pdf[l];
             shadow_rays |= 1 << l;
