@@ -1,7 +1,8 @@
 //! Raw BVH throughput: closest-hit and occlusion rays per second on the bundled scenes, with the rays an
 //! integrator would trace (eight samples in each of 8 192 pixels spread over the image: camera rays, then
 //! shadow segments from the hit points to points on the lights), traced one at a time; the same shadow rays
-//! eight at a time (a pixel's, one per lane), and camera rays through each pixel's cone of candidate
+//! skipping their light's convex emitter group, as the integrator traces them; the same shadow rays eight at
+//! a time (a pixel's, one per lane), and camera rays through each pixel's cone of candidate
 //! triangles, as the integrator traces them; and, in the same run, the rays per second of the `emitter`
 //! integrator itself (passes of 32 samples per pixel over the scene's image), so the rates compare under the
 //! same machine load.
@@ -11,7 +12,7 @@ use glam::Vec3;
 use illumlab::math::{SampleRng, Vec3x8, offset_ray_origin};
 use illumlab::render::{Film, RenderSettings, Renderer, SEGMENT_END, Strategy};
 use illumlab::sampling::sample_uniform_triangle;
-use illumlab::scene::{EmitterSampler, LightSelection, Scene, load_scene};
+use illumlab::scene::{EmitterSampler, LightSelection, SKIP_NONE, Scene, load_scene};
 use std::hint::black_box;
 
 const RAYS: usize = 1 << 16;
@@ -22,6 +23,8 @@ struct Workload {
     /// Segments `o + t·d`, 0 < t < [`SEGMENT_END`], from a hit point to a point on a light, as the integrator
     /// traces them (both ends moved off their surfaces).
     shadow: Vec<(Vec3, Vec3)>,
+    /// Per shadow segment, the group the integrator lets it skip (the light's convex emitter group), if any.
+    skip: Vec<Option<u32>>,
     /// The same segments grouped by pixel: origins, directions and the lanes in use.
     shadow_lanes: Vec<(Vec3x8, Vec3x8, u32)>,
 }
@@ -31,7 +34,7 @@ fn workload(scene: &Scene) -> Workload {
     let emitters = EmitterSampler::new(scene, LightSelection::Power).expect("scene has emitters");
     let (w, h) = (scene.camera.width, scene.camera.height);
     let pixels = RAYS / PER_PIXEL;
-    let mut work = Workload { primary: Vec::new(), shadow: Vec::new(), shadow_lanes: Vec::new() };
+    let mut work = Workload { primary: Vec::new(), shadow: Vec::new(), skip: Vec::new(), shadow_lanes: Vec::new() };
     for k in 0..pixels as u64 {
         let pixel = k * (w * h) as u64 / pixels as u64;
         let (x, y) = ((pixel % w as u64) as u32, (pixel / w as u64) as u32);
@@ -60,6 +63,7 @@ fn workload(scene: &Scene) -> Workload {
             let l = lanes.2.count_ones() as usize;
             (lanes.0[l], lanes.1[l], lanes.2) = (from, d, lanes.2 | 1 << l);
             work.shadow.push((from, d));
+            work.skip.push(if light.n.dot(from - x) > 0.0 { scene.convex_group(t) } else { None });
         }
         if lanes.2 != 0 {
             work.shadow_lanes.push((Vec3x8::from_lanes(&lanes.0), Vec3x8::from_lanes(&lanes.1), lanes.2));
@@ -88,7 +92,16 @@ fn rays(c: &mut Criterion) {
             b.iter(|| {
                 let mut blocked = 0u32;
                 for &(o, d) in &work.shadow {
-                    blocked += scene.accel().occluded(o, d, SEGMENT_END) as u32;
+                    blocked += scene.accel().occluded(o, d, SEGMENT_END, None) as u32;
+                }
+                black_box(blocked)
+            })
+        });
+        group.bench_function("occluded_skipping", |b| {
+            b.iter(|| {
+                let mut blocked = 0u32;
+                for (&(o, d), &skip) in work.shadow.iter().zip(&work.skip) {
+                    blocked += scene.accel().occluded(o, d, SEGMENT_END, skip) as u32;
                 }
                 black_box(blocked)
             })
@@ -97,7 +110,7 @@ fn rays(c: &mut Criterion) {
             b.iter(|| {
                 let mut blocked = 0u32;
                 for (o, d, active) in &work.shadow_lanes {
-                    blocked += scene.accel().occluded_lanes(o, d, SEGMENT_END, *active).count_ones();
+                    blocked += scene.accel().occluded_lanes(o, d, SEGMENT_END, *active, [SKIP_NONE; 8]).count_ones();
                 }
                 black_box(blocked)
             })

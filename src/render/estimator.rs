@@ -4,8 +4,9 @@
 use super::strategy::{DirectionSample, MisSettings, Target};
 use super::{RenderSettings, ShadingPoint, Strategy};
 use crate::math::{SampleRng, Vec3x8, offset_ray_origin, offset_ray_origins};
-use crate::scene::{EmitterSampler, Scene};
+use crate::scene::{EmitterSampler, SKIP_NONE, Scene};
 use glam::Vec3;
+use wide::{CmpGt, f32x8};
 
 /// Estimates the reflected radiance at `sp` with one sample of the settings' strategy. Returns the contribution
 /// (possibly non-finite for pathological input: callers drop and count such samples) and adds the rays traced.
@@ -43,7 +44,7 @@ fn integrand(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, rays: &mut u
         }
         Target::Emitter { triangle, point } => {
             let (value, n_x) = unshadowed(scene, sp, s, triangle)?;
-            visible(scene, sp.p, sp.n, point, n_x, rays).then_some((value, (triangle, point)))
+            visible(scene, sp.p, sp.n, (triangle, point, n_x), rays).then_some((value, (triangle, point)))
         }
     }
 }
@@ -101,25 +102,31 @@ fn estimate_mis(
     total
 }
 
-/// Shadow ray between p (normal n, on the side of x) and the point x on an emitter (normal n_x, facing p): both
-/// ends are moved off their surfaces (Ray Tracing Gems ch. 6), so neither triangle occludes itself.
+/// Shadow ray between p (normal n, on the side of x) and the point x on the emitter triangle Δ (normal n_x,
+/// facing p), given as (Δ, x, n_x): both ends are moved off their surfaces (Ray Tracing Gems ch. 6), so neither
+/// triangle occludes itself. From in front of Δ's plane, the ray skips the rest of Δ's convex emitter group,
+/// which it cannot meet (`scene::convex`).
 #[inline]
-pub fn visible(scene: &Scene, p: Vec3, n: Vec3, x: Vec3, n_x: Vec3, rays: &mut u64) -> bool {
+pub fn visible(scene: &Scene, p: Vec3, n: Vec3, (triangle, x, n_x): (u32, Vec3, Vec3), rays: &mut u64) -> bool {
     *rays += 1;
     let from = offset_ray_origin(p, n);
     let to = offset_ray_origin(x, n_x);
-    !scene.accel().occluded(from, to - from, SEGMENT_END)
+    let skip = if n_x.dot(from - x) > 0.0 { scene.convex_group(triangle) } else { None };
+    !scene.accel().occluded(from, to - from, SEGMENT_END, skip)
 }
 
-/// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i); returns
-/// the visible ones. Lane i's answer is `visible`'s, bit for bit.
+/// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i), lane i's
+/// point x on a triangle of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible
+/// ones. Lane i's answer is `visible`'s, bit for bit.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn visible_lanes(
     scene: &Scene,
     p: Vec3x8,
     n: Vec3x8,
     x: Vec3x8,
     n_x: Vec3x8,
+    groups: [u32; 8],
     active: u32,
     rays: &mut u64,
 ) -> u32 {
@@ -129,8 +136,61 @@ pub(super) fn visible_lanes(
     *rays += active.count_ones() as u64;
     let from = offset_ray_origins(p, n);
     let to = offset_ray_origins(x, n_x);
-    active & !scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, active)
+    let mut skips = [SKIP_NONE; 8];
+    if groups != skips {
+        let in_front = n_x.dot(from - x).cmp_gt(f32x8::ZERO).move_mask();
+        skips = std::array::from_fn(|l| if in_front & (1 << l) != 0 { groups[l] } else { SKIP_NONE });
+    }
+    active & !scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, active, skips)
 }
 
 /// Shadow rays run along `from + t·(to − from)` for 0 < t < 1 − 10⁻⁶ (the direction is not a unit vector).
 pub const SEGMENT_END: f32 = 1.0 - 1e-6;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::sample_uniform_triangle;
+    use crate::scene::load_scene;
+
+    /// A shadow ray that skips its light's convex emitter group answers as one that tests every triangle: from
+    /// points anywhere around veach-mis's sphere lights and from points just above their surfaces, to uniform
+    /// points on triangles of those lights facing them.
+    #[test]
+    fn skipping_the_lights_own_group_changes_no_shadow_ray() {
+        let scene = load_scene("veach-mis").expect("bundled scene");
+        let lights: Vec<u32> = scene.emitters.iter().copied().filter(|&t| scene.convex_group(t).is_some()).collect();
+        assert_eq!(lights.len(), 560, "the four sphere lights are convex groups");
+        let (lo, hi) = lights
+            .iter()
+            .flat_map(|&t| scene.triangles[t as usize].v)
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let (centre, extent) = ((lo + hi) * 0.5, (hi - lo) * 2.0);
+        let (mut tested, mut blocked) = (0, 0);
+        for k in 0..40_000u64 {
+            let mut rng = SampleRng::new(5, k, 0);
+            let light = lights[(rng.uniform() * lights.len() as f32) as usize];
+            let tri = &scene.triangles[light as usize];
+            let x = sample_uniform_triangle(rng.uniform_2d(), tri.v[0], tri.v[1], tri.v[2]);
+            let p = if k % 2 == 0 {
+                let u = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
+                centre + u * extent
+            } else {
+                // Just above the light, 10⁻⁴ to 10⁻¹ m from x, in a direction on its emitting side.
+                let d = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5;
+                x + (d + tri.n).normalize() * 10f32.powf(-4.0 + 3.0 * rng.uniform())
+            };
+            let n = (x - p).normalize();
+            let (from, to) = (offset_ray_origin(p, n), offset_ray_origin(x, tri.n));
+            if !(tri.n.dot(from - x) > 0.0) {
+                continue;
+            }
+            let skip = scene.convex_group(light);
+            let full = scene.accel().occluded(from, to - from, SEGMENT_END, None);
+            assert_eq!(scene.accel().occluded(from, to - from, SEGMENT_END, skip), full, "ray {k}: {p} to {x}");
+            tested += 1;
+            blocked += full as u32;
+        }
+        assert!(tested > 20_000 && blocked > 500, "{tested} rays, {blocked} blocked: the test checks too little");
+    }
+}

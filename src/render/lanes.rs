@@ -9,7 +9,7 @@
 use super::estimator::{unshadowed, visible_lanes};
 use super::{LightTechnique, ShadingPoint, Target};
 use crate::math::{SampleRng, Vec3x8};
-use crate::scene::{EmitterSampler, Hit, Scene};
+use crate::scene::{EmitterSampler, Hit, SKIP_NONE, Scene};
 use glam::{Vec2, Vec3};
 use wide::{CmpGt, CmpLt, f32x8};
 
@@ -50,25 +50,26 @@ pub fn estimate_emitter_lanes(
     // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ.
     let mut light = [[Vec3::ZERO; LANES]; 4]; // v₀, v₁, v₂, n_Δ
     let (mut p_delta, mut area, mut uv) = ([0.0; LANES], [1.0; LANES], [Vec2::ZERO; LANES]);
-    // The picked triangle's material (u32::MAX for none).
+    // The picked triangle's material (u32::MAX for none) and convex emitter group.
     let mut light_material = [u32::MAX; LANES];
+    let mut light_group = [SKIP_NONE; LANES];
     for (l, hit) in hits.iter().enumerate() {
         if hit.is_none() {
             continue;
         }
         let u = rngs[l].uniform();
-        let (v, n_delta, a, pd, material) = match emitters.pick_fixed(u) {
-            Some(e) => (e.v, e.n, e.area, e.p_delta, e.material),
+        let (v, n_delta, a, pd, material, group) = match emitters.pick_fixed(u) {
+            Some(e) => (e.v, e.n, e.area, e.p_delta, e.material, e.convex_group),
             None => {
                 let Some((t, pd)) = emitters.pick(scene, p.lane(l), u) else { continue };
                 let tri = &scene.triangles[t as usize];
-                (tri.v, tri.n, tri.area, pd, tri.material)
+                (tri.v, tri.n, tri.area, pd, tri.material, scene.convex_group(t).unwrap_or(SKIP_NONE))
             }
         };
         // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not has drawn two uniforms
         // more than the one-sample estimator, which no later step of its sample reads.
         (0..3).for_each(|k| light[k][l] = v[k]);
-        (light[3][l], area[l], p_delta[l], light_material[l]) = (n_delta, a, pd, material);
+        (light[3][l], area[l], p_delta[l], light_material[l], light_group[l]) = (n_delta, a, pd, material, group);
         uv[l] = rngs[l].uniform_2d();
     }
     let [la, lb, lc, ln] = light.map(|v| Vec3x8::from_lanes(&v));
@@ -116,7 +117,7 @@ pub fn estimate_emitter_lanes(
             shadow_rays |= 1 << l;
         }
     }
-    let visible = visible_lanes(scene, p, n, x, ln, shadow_rays, rays);
+    let visible = visible_lanes(scene, p, n, x, ln, light_group, shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
 
@@ -136,6 +137,7 @@ pub fn estimate_light_lanes(
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal.
     let mut ends = [[Vec3::ZERO; LANES]; 4];
+    let mut groups = [SKIP_NONE; LANES];
     let mut shadow_rays = 0;
     for (l, hit) in hits.iter().enumerate() {
         let Some(hit) = hit else { continue };
@@ -148,9 +150,10 @@ pub fn estimate_light_lanes(
         let Some((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
         reflected[l] = value / s.pdf;
         (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
+        groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
         shadow_rays |= 1 << l;
     }
     let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
-    let visible = visible_lanes(scene, p, n, x, n_x, shadow_rays, rays);
+    let visible = visible_lanes(scene, p, n, x, n_x, groups, shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }

@@ -1,6 +1,6 @@
 //! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
-use super::Scene;
+use super::{SKIP_NONE, Scene};
 use crate::math::luminance;
 use crate::sampling::DiscreteDistribution;
 use glam::Vec3;
@@ -66,6 +66,8 @@ pub struct EmitterTriangle {
     pub area: f32,
     pub p_delta: f32,
     pub material: u32,
+    /// [`Scene::convex_group`] of the triangle, or [`SKIP_NONE`] (an `Option` would not fit the cache line).
+    pub convex_group: u32,
 }
 
 impl EmitterSampler {
@@ -103,7 +105,8 @@ impl EmitterSampler {
             let record = |(slot, &t): (usize, &u32)| {
                 let tri = &scene.triangles[t as usize];
                 let p_delta = distribution.pmf(slot);
-                EmitterTriangle { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material }
+                let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
+                EmitterTriangle { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material, convex_group }
             };
             scene.emitters.iter().enumerate().map(record).collect()
         };
@@ -202,6 +205,7 @@ mod tests {
                 let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
                 let tri = &scene.triangles[t as usize];
                 assert_eq!((e.v, e.n, e.area, e.p_delta, e.material), (tri.v, tri.n, tri.area, p_delta, tri.material));
+                assert_eq!(e.convex_group, scene.convex_group(t).unwrap_or(SKIP_NONE));
             }
         }
     }

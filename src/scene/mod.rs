@@ -4,13 +4,14 @@
 mod accel;
 mod bundled;
 mod camera;
+mod convex;
 mod emitters;
 mod error;
 mod file;
 mod load;
 mod material;
 
-pub use accel::{Accel, ConeCandidates, Hit};
+pub use accel::{Accel, ConeCandidates, Hit, SKIP_NONE};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
@@ -47,6 +48,8 @@ pub struct Scene {
     /// Things the user should know that do not stop rendering (no emitter, non-energy-conserving material, …).
     pub warnings: Vec<String>,
     accel: Accel,
+    /// Per triangle, its convex emitter group (see `convex`), which the shadow rays towards it may skip.
+    convex_groups: Vec<Option<u32>>,
 }
 
 impl Scene {
@@ -91,7 +94,11 @@ impl Scene {
         if dropped > 0 {
             warnings.push(format!("{dropped} degenerate (zero-area) triangle(s) ignored"));
         }
-        let (accel, order) = Accel::build(&kept);
+        let groups = convex::convex_emitter_groups(&kept, |i| materials[kept_ids[i] as usize].is_emissive());
+        let (accel, order) = Accel::build(&kept, &groups);
+        // Only groups that some subtree holds apart spare a shadow ray any work.
+        let apart = accel.groups_held_apart();
+        let convex_groups = order.iter().map(|&i| groups[i as usize].filter(|g| apart.contains(g))).collect();
         let triangles: Vec<Triangle> = order
             .iter()
             .map(|&i| {
@@ -107,12 +114,29 @@ impl Scene {
         if emitters.is_empty() {
             warnings.push("the scene has no emitter: the image will be black".into());
         }
-        Ok(Self { name: name.into(), camera, triangles, materials, material_names, emitters, warnings, accel })
+        Ok(Self {
+            name: name.into(),
+            camera,
+            triangles,
+            materials,
+            material_names,
+            emitters,
+            warnings,
+            accel,
+            convex_groups,
+        })
     }
 
     #[inline]
     pub fn accel(&self) -> &Accel {
         &self.accel
+    }
+
+    /// The convex emitter group of triangle `t`, if any: a shadow ray from in front of t's plane to a point on
+    /// t meets no other triangle of the group, so it may skip them ([`Accel::occluded`]).
+    #[inline]
+    pub fn convex_group(&self, t: u32) -> Option<u32> {
+        self.convex_groups[t as usize]
     }
 
     /// The hit point from its barycentrics rather than `o + t·d`, whose error grows with the distance travelled

@@ -3,7 +3,7 @@
 //! the child with the largest surface area (Wald et al., "Getting Rid of Packets", 2008). Each binary leaf (at
 //! most eight triangles) becomes one packet: testing eight triangles at once costs what testing one does.
 
-use super::node::{Child, Node8};
+use super::node::{Child, ChildGroups, NO_GROUP, Node8};
 use super::packet::TrianglePacket;
 use glam::Vec3;
 use obvhs::{
@@ -21,33 +21,47 @@ const WIDTH: usize = 8;
 
 pub(super) struct Built {
     pub nodes: Vec<Node8>,
+    /// The groups of each node's children.
+    pub groups: Vec<ChildGroups>,
     pub packets: Vec<TrianglePacket>,
     pub root: Child,
     /// `order[i]` = input index of the i-th stored triangle; packets refer to stored indices.
     pub order: Vec<u32>,
 }
 
-/// Builds the tree over a non-empty triangle list.
-pub(super) fn build(positions: &[[Vec3; 3]]) -> Built {
+/// Builds the tree over a non-empty triangle list, with each triangle's group (see [`super::Accel::build`]).
+pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
     let input: Vec<ObvhsTriangle> =
         positions.iter().map(|[a, b, c]| ObvhsTriangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect();
     let bvh = build_bvh2_from_tris(&input, BvhBuildParams::medium_build(), &mut Duration::default());
-    let mut builder = Builder { bvh: &bvh, positions, nodes: vec![], packets: vec![], order: vec![] };
-    let root = builder.child(0, 0);
-    Built { nodes: builder.nodes, packets: builder.packets, root, order: builder.order }
+    let groups = groups
+        .iter()
+        .map(|g| {
+            g.map_or(NO_GROUP, |g| i32::try_from(g).ok().filter(|&g| g < i32::MAX - 1).expect("group id below 2³¹ − 2"))
+        })
+        .collect();
+    let mut builder =
+        Builder { bvh: &bvh, positions, groups, nodes: vec![], child_groups: vec![], packets: vec![], order: vec![] };
+    let (root, _) = builder.child(0, 0);
+    let (nodes, groups, packets, order) = (builder.nodes, builder.child_groups, builder.packets, builder.order);
+    Built { nodes, groups, packets, root, order }
 }
 
 struct Builder<'a> {
     bvh: &'a Bvh2,
     positions: &'a [[Vec3; 3]],
+    /// Per input triangle, its group or [`NO_GROUP`].
+    groups: Vec<i32>,
     nodes: Vec<Node8>,
+    child_groups: Vec<ChildGroups>,
     packets: Vec<TrianglePacket>,
     order: Vec<u32>,
 }
 
 impl Builder<'_> {
-    /// The wide child standing for binary node `id`, at `depth` wide levels below the root.
-    fn child(&mut self, id: usize, depth: usize) -> Child {
+    /// The wide child standing for binary node `id`, at `depth` wide levels below the root, and the group all
+    /// its triangles belong to (or [`NO_GROUP`]).
+    fn child(&mut self, id: usize, depth: usize) -> (Child, i32) {
         if !self.splits(id) || depth >= MAX_DEPTH {
             return self.leaf(id);
         }
@@ -64,15 +78,17 @@ impl Builder<'_> {
         }
         let slot = self.nodes.len();
         self.nodes.push(Node8::new(&[]));
-        let children: Vec<([Vec3; 2], Child)> = open
-            .into_iter()
-            .map(|c| {
-                let aabb = self.bvh.nodes[c].aabb;
-                ([aabb.min.into(), aabb.max.into()], self.child(c, depth + 1))
-            })
-            .collect();
+        self.child_groups.push(ChildGroups::new(&[]));
+        let (mut children, mut groups) = (Vec::new(), Vec::new());
+        for c in open {
+            let aabb = self.bvh.nodes[c].aabb;
+            let (child, group) = self.child(c, depth + 1);
+            children.push(([aabb.min.into(), aabb.max.into()], child));
+            groups.push(group);
+        }
         self.nodes[slot] = Node8::new(&children);
-        Child { first: slot as u32, packets: 0 }
+        self.child_groups[slot] = ChildGroups::new(&groups);
+        (Child { first: slot as u32, packets: 0 }, common_group(&groups))
     }
 
     /// Whether binary node `id` becomes a wide node rather than a leaf: obvhs's leaves (at most eight triangles,
@@ -88,7 +104,7 @@ impl Builder<'_> {
     }
 
     /// Every triangle under binary node `id`, eight to a packet.
-    fn leaf(&mut self, id: usize) -> Child {
+    fn leaf(&mut self, id: usize) -> (Child, i32) {
         let mut triangles = Vec::new();
         let mut stack = vec![id];
         while let Some(n) = stack.pop() {
@@ -111,6 +127,15 @@ impl Builder<'_> {
                 .collect();
             self.packets.push(TrianglePacket::new(&lanes));
         }
-        Child { first: first_packet, packets: self.packets.len() as u32 - first_packet }
+        let group = common_group(&triangles.iter().map(|&t| self.groups[t as usize]).collect::<Vec<_>>());
+        (Child { first: first_packet, packets: self.packets.len() as u32 - first_packet }, group)
+    }
+}
+
+/// The group shared by all of `groups`, or [`NO_GROUP`].
+fn common_group(groups: &[i32]) -> i32 {
+    match groups {
+        [first, rest @ ..] if rest.iter().all(|g| g == first) => *first,
+        _ => NO_GROUP,
     }
 }

@@ -13,7 +13,7 @@ mod traverse;
 
 pub use frustum::ConeCandidates;
 use glam::Vec3;
-use node::{Child, Node8};
+use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;
 
 /// Acceleration structure over the scene's triangles, stored in the BVH's leaf order so that a hit's triangle
@@ -21,10 +21,15 @@ use packet::TrianglePacket;
 #[derive(Clone)]
 pub struct Accel {
     nodes: Vec<Node8>,
+    /// The groups of each node's children (see [`Accel::build`]).
+    groups: Vec<ChildGroups>,
     packets: Vec<TrianglePacket>,
     /// `None` for a scene without triangles.
     root: Option<Child>,
 }
+
+/// The group a shadow ray skips when it skips none (see [`Accel::build`]).
+pub const SKIP_NONE: u32 = u32::MAX;
 
 /// A closest hit: the triangle (in stored order), the distance (in lengths of the ray's direction), and the barycentric
 /// coordinates of the hit point, `x = v₀ + u (v₁ − v₀) + v (v₂ − v₀)`.
@@ -38,12 +43,26 @@ pub struct Hit {
 
 impl Accel {
     /// Builds the BVH; returns it with the permutation `order[i]` = input index of the i-th stored triangle.
-    pub fn build(positions: &[[Vec3; 3]]) -> (Self, Vec<u32>) {
+    /// `groups[i]` is the group of input triangle i (below 2³¹ − 2), if any: an any-hit query may skip one group, and does not
+    /// enter the subtrees that hold only its triangles (the build does not mix groups on purpose: it keeps them
+    /// apart where they lie apart, e.g. one light's triangles from the rest).
+    pub fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> (Self, Vec<u32>) {
+        assert_eq!(positions.len(), groups.len(), "one group (or none) per triangle");
         if positions.is_empty() {
-            return (Self { nodes: Vec::new(), packets: Vec::new(), root: None }, Vec::new());
+            return (Self { nodes: Vec::new(), groups: Vec::new(), packets: Vec::new(), root: None }, Vec::new());
         }
-        let built = build::build(positions);
-        (Self { nodes: built.nodes, packets: built.packets, root: Some(built.root) }, built.order)
+        let built = build::build(positions, groups);
+        (Self { nodes: built.nodes, groups: built.groups, packets: built.packets, root: Some(built.root) }, built.order)
+    }
+}
+
+impl Accel {
+    /// The groups (see [`Accel::build`]) that some subtree holds apart: the only ones worth skipping.
+    pub fn groups_held_apart(&self) -> Vec<u32> {
+        let mut groups: Vec<u32> = self.groups.iter().flat_map(ChildGroups::groups).collect();
+        groups.sort_unstable();
+        groups.dedup();
+        groups
     }
 }
 
@@ -98,8 +117,23 @@ mod tests {
             .collect()
     }
 
+    /// Groups that the BVH can hold apart: triangles with centroid x > 2 in group 0, x < −2 in group 1.
+    fn groups_by_side(tris: &[[Vec3; 3]]) -> Vec<Option<u32>> {
+        let group = |[a, b, c]: &[Vec3; 3]| match (a.x + b.x + c.x) / 3.0 {
+            x if x > 2.0 => Some(0),
+            x if x < -2.0 => Some(1),
+            _ => None,
+        };
+        tris.iter().map(group).collect()
+    }
+
+    /// Closest hits and any hits against every triangle tested alone; any hits skipping group 0 against every
+    /// triangle outside it (a clear hit on one of them is found; with no triangle hit at all, none is).
     fn check_against_brute_force(tris: &[[Vec3; 3]], rays: u64) {
-        let (accel, order) = Accel::build(tris);
+        let groups = groups_by_side(tris);
+        let (accel, order) = Accel::build(tris, &groups);
+        let stored_groups: Vec<_> = order.iter().map(|&i| groups[i as usize]).collect();
+        let mut skipped = 0;
         let stored: Vec<[Vec3; 3]> = order.iter().map(|&i| tris[i as usize]).collect();
         let mut sorted = order.clone();
         sorted.sort_unstable();
@@ -143,12 +177,21 @@ mod tests {
                 }
                 None => assert!(nearest_clear.is_none(), "ray {r}: the BVH missed a hit at {nearest_clear:?}"),
             }
-            let occluded = accel.occluded(o, d, t_max);
+            let occluded = accel.occluded(o, d, t_max, None);
+            let skipping = accel.occluded(o, d, t_max, Some(0));
             if nearest_clear.is_some() {
                 assert!(occluded, "ray {r}: any-hit missed a hit");
             } else if verdicts.iter().all(|v| *v == Verdict::Miss) {
-                assert!(!occluded, "ray {r}: any-hit found a hit where there is none");
+                assert!(!occluded && !skipping, "ray {r}: any-hit found a hit where there is none");
             }
+            let outside = |(k, v): (usize, &Verdict)| stored_groups[k] != Some(0) && matches!(v, Verdict::Hit(_));
+            if verdicts.iter().enumerate().any(outside) {
+                assert!(skipping, "ray {r}: any-hit skipping group 0 missed a hit outside it");
+            }
+            skipped += (occluded && !skipping) as u32;
+        }
+        if tris.len() >= 100 {
+            assert!(skipped > 0, "no ray was spared group 0's triangles: the skip is not tested");
         }
         assert!(hits > rays / 8, "the test rays mostly miss ({hits} hits): it checks too little");
     }
@@ -162,14 +205,14 @@ mod tests {
 
     /// Eight rays walking the BVH together, one per lane, answer as each does alone, bit for bit: bundles from
     /// nearby origins towards one region (as a pixel's shadow rays) and bundles of unrelated rays, with some
-    /// lanes inactive, on soups of every size (where fewer than five rays enter a subtree, they walk it alone,
+    /// lanes inactive and each lane skipping a group or none, on soups of every size (where fewer than five rays enter a subtree, they walk it alone,
     /// interleaved).
     #[test]
     fn eight_rays_together_answer_as_each_alone() {
         let mut occluded = 0;
         for (n, size) in [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)] {
             let tris = random_soup(n, size, 40 + n as u64);
-            let (accel, _) = Accel::build(&tris);
+            let (accel, _) = Accel::build(&tris, &groups_by_side(&tris));
             for group in 0..1500u64 {
                 let mut rng = SampleRng::new(17, group, n as u64);
                 let mut point =
@@ -182,10 +225,12 @@ mod tests {
                 let dirs: [Vec3; 8] = std::array::from_fn(|l| ends[l] - origins[l]);
                 let active = (group as u32).wrapping_mul(0x9e37_79b9) >> 24 | 1;
                 let t_max = [1.0 - 1e-6, 0.5, f32::INFINITY][group as usize % 3];
-                let bits =
-                    accel.occluded_lanes(&Vec3x8::from_lanes(&origins), &Vec3x8::from_lanes(&dirs), t_max, active);
+                let skips = std::array::from_fn(|l| [SKIP_NONE, 0, 1][(group as usize + l) % 3]);
+                let (origins_x8, dirs_x8) = (Vec3x8::from_lanes(&origins), Vec3x8::from_lanes(&dirs));
+                let bits = accel.occluded_lanes(&origins_x8, &dirs_x8, t_max, active, skips);
                 for l in 0..8 {
-                    let alone = active & (1 << l) != 0 && accel.occluded(origins[l], dirs[l], t_max);
+                    let alone = active & (1 << l) != 0
+                        && accel.occluded(origins[l], dirs[l], t_max, Some(skips[l]).filter(|&s| s != SKIP_NONE));
                     assert_eq!(bits & (1 << l) != 0, alone, "soup {n}, group {group}, lane {l}");
                     occluded += alone as u32;
                 }
@@ -205,9 +250,9 @@ mod tests {
 
     #[test]
     fn an_empty_scene_is_never_hit() {
-        let (accel, order) = Accel::build(&[]);
+        let (accel, order) = Accel::build(&[], &[]);
         assert!(order.is_empty());
         assert!(accel.closest_hit(Vec3::ZERO, Vec3::X, f32::INFINITY).is_none());
-        assert!(!accel.occluded(Vec3::ZERO, Vec3::X, f32::INFINITY));
+        assert!(!accel.occluded(Vec3::ZERO, Vec3::X, f32::INFINITY, None));
     }
 }

@@ -3,7 +3,7 @@
 
 use super::ray::{RayLanes, WideRay};
 use glam::Vec3;
-use wide::{CmpLe, CmpLt, f32x8};
+use wide::{CmpEq, CmpLe, CmpLt, f32x8, i32x8};
 
 /// `1 + 2γ₃` with `γₙ = nε/(1 − nε)`, ε = 2⁻²⁴: scaling the exit distance by it makes the slab test
 /// conservative under float rounding (Ize 2013), so no ray slips between a box and the triangle inside it.
@@ -37,6 +37,18 @@ pub(super) struct Node8 {
     /// Bit i set when lane i holds a child.
     used: u32,
 }
+
+/// Per child of a node, the group all its triangles belong to (see [`super::Accel::build`]), or [`NO_GROUP`].
+/// Kept beside the nodes, not in them: only a ray that skips a group reads it, and nodes stay 288 bytes.
+#[derive(Clone, Debug)]
+pub(super) struct ChildGroups(i32x8);
+
+/// A child whose triangles are not all in one group.
+pub(super) const NO_GROUP: i32 = -2;
+
+/// What a ray that skips no group compares the children's groups with ([`super::SKIP_NONE`] as i32): no child
+/// has it.
+pub(super) const SKIP_NOTHING: i32 = super::SKIP_NONE as i32;
 
 impl Node8 {
     pub fn new(children: &[([Vec3; 2], Child)]) -> Self {
@@ -107,6 +119,32 @@ impl Node8 {
             outside |= s.cmp_lt(f32x8::ZERO);
         }
         !(outside.move_mask() as u32) & self.used
+    }
+}
+
+impl ChildGroups {
+    /// Child i's group is `groups[i]` (a group id or [`NO_GROUP`]); the children past `groups` have none.
+    pub fn new(groups: &[i32]) -> Self {
+        let mut lanes = [NO_GROUP; 8];
+        lanes[..groups.len()].copy_from_slice(groups);
+        Self(i32x8::new(lanes))
+    }
+
+    /// The children whose triangles all belong to group `skip` (bit i for child i; none for [`SKIP_NOTHING`]).
+    #[inline(always)]
+    pub fn in_group(&self, skip: i32) -> u32 {
+        self.0.cmp_eq(i32x8::splat(skip)).move_mask() as u32
+    }
+
+    /// The groups of the children that lie wholly in one.
+    pub fn groups(&self) -> impl Iterator<Item = u32> + '_ {
+        self.0.as_array_ref().iter().filter_map(|&g| u32::try_from(g).ok())
+    }
+
+    /// Group of child k (or [`NO_GROUP`]).
+    #[inline(always)]
+    pub fn group(&self, k: usize) -> i32 {
+        self.0.as_array_ref()[k]
     }
 }
 

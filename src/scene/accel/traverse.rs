@@ -5,12 +5,13 @@
 //! when it is found occluded; where too few of them enter a subtree, they walk on alone but interleaved.
 
 use super::build::MAX_DEPTH;
-use super::node::Child;
+use super::node::{Child, SKIP_NOTHING};
 use super::ray::{RayLanes, WideRay};
 use super::{Accel, Hit};
 use crate::math::Vec3x8;
 use arrayvec::ArrayVec;
 use glam::Vec3;
+use wide::{CmpEq, i32x8};
 
 /// Each level pushes at most seven children (the eighth is visited at once).
 pub(super) const STACK: usize = 7 * MAX_DEPTH + 8;
@@ -76,19 +77,21 @@ impl Accel {
     }
 
     /// True when something lies on `origin + t·dir` for 0 < t < t_max (`dir` need not be a unit vector: t
-    /// counts in its lengths); stops at the first hit found.
-    #[inline]
-    pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32) -> bool {
-        self.root.is_some_and(|root| self.occluded_below(root, &WideRay::new(origin, dir), t_max))
+    /// counts in its lengths), leaving out the triangles of group `skip` (see [`Accel::build`]) where the tree
+    /// holds them apart; stops at the first hit found.
+    #[inline(always)]
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, t_max: f32, skip: Option<u32>) -> bool {
+        let Some(root) = self.root else { return false };
+        self.occluded_below(root, &WideRay::new(origin, dir), t_max, skip_code(skip))
     }
 
     /// [`Accel::occluded`] within the subtree `start`.
     #[inline]
-    fn occluded_below(&self, start: Child, ray: &WideRay, t_max: f32) -> bool {
+    fn occluded_below(&self, start: Child, ray: &WideRay, t_max: f32, skip: i32) -> bool {
         let mut stack = AnyHitStack::new();
         stack.push(start);
         while !stack.is_empty() {
-            if self.occlusion_step(&mut stack, ray, t_max) {
+            if self.occlusion_step(&mut stack, ray, t_max, skip) {
                 return true;
             }
         }
@@ -96,10 +99,11 @@ impl Accel {
     }
 
     /// One step of an any-hit walk: takes the subtree on top of `stack` and tests a leaf's triangles or a node's
-    /// children, testing the leaves among them at once and pushing the nodes (the order does not matter for any
-    /// hit). True when a triangle in range was found; false also for an empty stack.
+    /// children (but those wholly in group `skip`), testing the leaves among them at once and pushing the nodes
+    /// (the order does not matter for any hit). True when a triangle in range was found; false also for an
+    /// empty stack.
     #[inline(always)]
-    fn occlusion_step(&self, stack: &mut AnyHitStack, ray: &WideRay, t_max: f32) -> bool {
+    fn occlusion_step(&self, stack: &mut AnyHitStack, ray: &WideRay, t_max: f32, skip: i32) -> bool {
         let leaf_hit = |leaf: Child| {
             self.packets[leaf.first as usize..(leaf.first + leaf.packets) as usize].iter().any(|p| p.any(ray, t_max))
         };
@@ -109,6 +113,9 @@ impl Accel {
         }
         let node = &self.nodes[current.first as usize];
         let mut mask = node.intersect(ray, t_max).0;
+        if skip != SKIP_NOTHING {
+            mask &= !self.groups[current.first as usize].in_group(skip);
+        }
         while mask != 0 {
             let child = node.children[mask.trailing_zeros() as usize];
             mask &= mask - 1;
@@ -121,9 +128,10 @@ impl Accel {
         false
     }
 
-    /// [`Accel::occluded`] for eight rays `origins + t·dirs`, one per lane, those in `active` (bit i for lane i);
-    /// returns the occluded ones. Ray i visits the leaves its own slab tests admit and meets their triangles
-    /// through the same arithmetic as alone, so its answer is [`Accel::occluded`]'s, bit for bit.
+    /// [`Accel::occluded`] for eight rays `origins + t·dirs`, one per lane, those in `active` (bit i for lane i),
+    /// ray i skipping group `skips[i]` (or none: [`super::SKIP_NONE`]); returns the occluded ones. Ray i visits
+    /// the leaves its own slab tests admit and meets their triangles through the same arithmetic as alone, so
+    /// its answer is [`Accel::occluded`]'s, bit for bit.
     ///
     /// The rays share the walk while at least [`PACKET_MIN_RAYS`] of them enter a subtree: the tests of a node's
     /// children for all of them are independent and overlap. A subtree fewer rays enter is set aside on the
@@ -132,14 +140,37 @@ impl Accel {
     /// one has [`SET_ASIDE`] subtrees set aside, and at the end. Where the rays part at the root (lights in
     /// different places), they all walk alone together.
     #[inline]
-    pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32) -> u32 {
+    pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32, skips: [u32; 8]) -> u32 {
         let Some(root) = self.root else { return 0 };
+        let skips = skips.map(|s| s as i32);
         let mut alone: [AnyHitStack; 8] = Default::default();
         if active.count_ones() < PACKET_MIN_RAYS {
             for_each_lane(active, |l| alone[l].push(root));
-            return self.walk_alone(&mut alone, active, origins, dirs, t_max);
+            return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
         }
         let rays = RayLanes::new(origins, dirs);
+        if skips.iter().any(|&s| s != SKIP_NOTHING) {
+            self.walk_together::<true>(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
+        } else {
+            self.walk_together::<false>(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
+        }
+    }
+
+    /// The shared walk of [`Accel::occluded_lanes`], with the rays' groups to skip tested only if `SKIPS`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn walk_together<const SKIPS: bool>(
+        &self,
+        root: Child,
+        active: u32,
+        rays: &RayLanes,
+        t_max: f32,
+        skips: &[i32; 8],
+        alone: &mut [AnyHitStack; 8],
+        origins: &Vec3x8,
+        dirs: &Vec3x8,
+    ) -> u32 {
+        let skip_lanes = i32x8::new(*skips);
         // The lanes with subtrees set aside, and those with no room left to set one more aside.
         let (mut occluded, mut set_aside, mut full) = (0, 0, 0);
         let mut stack = ArrayVec::<(Child, u32), { STACK + MAX_DEPTH }>::new();
@@ -150,7 +181,7 @@ impl Accel {
             // Rays about to go on together, or to set one more subtree aside, first walk alone.
             let walk_first = if few { full } else { set_aside };
             if lanes & walk_first != 0 {
-                occluded |= self.walk_alone(&mut alone, set_aside, origins, dirs, t_max);
+                occluded |= self.walk_alone(alone, set_aside, origins, dirs, t_max, skips);
                 (set_aside, full) = (0, 0);
                 lanes &= !occluded;
             }
@@ -167,7 +198,7 @@ impl Accel {
             }
             if current.is_leaf() {
                 for packet in &self.packets[current.first as usize..(current.first + current.packets) as usize] {
-                    let hit = packet.any_of_rays(&rays, t_max) & lanes;
+                    let hit = packet.any_of_rays(rays, t_max) & lanes;
                     occluded |= hit;
                     lanes &= !hit;
                     if lanes == 0 {
@@ -184,18 +215,23 @@ impl Accel {
             while children != 0 {
                 let k = children.trailing_zeros() as usize;
                 children &= children - 1;
-                let entered = node.intersect_lanes(k, &rays, t_max) & lanes;
+                let mut entered = node.intersect_lanes(k, rays, t_max) & lanes;
+                if SKIPS {
+                    let group = self.groups[current.first as usize].group(k);
+                    entered &= !(skip_lanes.cmp_eq(i32x8::splat(group)).move_mask() as u32);
+                }
                 if entered != 0 {
                     stack.push((node.children[k], entered));
                 }
             }
         }
-        occluded | self.walk_alone(&mut alone, set_aside, origins, dirs, t_max)
+        occluded | self.walk_alone(alone, set_aside, origins, dirs, t_max, skips)
     }
 
     /// The rays of `lanes` (bit i for lane i) walk the subtrees on their stacks in `stacks`, each alone, one step
-    /// of each in turn: the walks are independent, so the dependent chain of each (node, box test, child)
-    /// overlaps the others' instead of waiting alone. Returns the occluded ones; leaves their stacks empty.
+    /// of each in turn, ray i skipping group code `skips[i]`: the walks are independent, so the dependent chain of
+    /// each (node, box test, child) overlaps the others' instead of waiting alone. Returns the occluded ones;
+    /// leaves their stacks empty.
     #[inline]
     fn walk_alone(
         &self,
@@ -204,6 +240,7 @@ impl Accel {
         origins: &Vec3x8,
         dirs: &Vec3x8,
         t_max: f32,
+        skips: &[i32; 8],
     ) -> u32 {
         if lanes == 0 {
             return 0; // nothing set aside: the common end of a coherent bundle's walk
@@ -214,7 +251,7 @@ impl Accel {
         while walking != 0 {
             for_each_lane(walking, |l| {
                 let Some(ray) = &rays[l] else { return };
-                if self.occlusion_step(&mut stacks[l], ray, t_max) {
+                if self.occlusion_step(&mut stacks[l], ray, t_max, skips[l]) {
                     occluded |= 1 << l;
                     stacks[l].clear();
                 }
@@ -225,6 +262,12 @@ impl Accel {
         }
         occluded
     }
+}
+
+/// A group to skip as the nodes store groups: its id, or [`SKIP_NOTHING`].
+#[inline(always)]
+fn skip_code(skip: Option<u32>) -> i32 {
+    skip.map_or(SKIP_NOTHING, |g| g as i32)
 }
 
 /// Subtrees set aside per ray in [`Accel::occluded_lanes`] before the rays walk alone.
