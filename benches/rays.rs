@@ -6,8 +6,14 @@
 //! triangles, as the integrator traces them; and, in the same run, the rays per second of the `emitter`
 //! integrator itself (passes of 32 samples per pixel over the scene's image), so the rates compare under the
 //! same machine load.
+//!
+//! After the criterion rows, unless a filter is given, the integrator's share of the raw rate is measured in
+//! rounds that alternate the raw rays (camera and shadow rays one at a time, as a mix) with an integrator pass,
+//! each timed by its thread's CPU clock: the machine's load drifts over seconds, so a ratio of two rows taken
+//! a minute apart moves by up to ±20%, where the ratio within a round holds still.
 
-use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
+use cpu_time::ThreadTime;
+use criterion::{Criterion, SamplingMode, Throughput, criterion_group};
 use glam::Vec3;
 use illumlab::math::{SampleRng, Vec3x8, offset_ray_origin};
 use illumlab::render::{Film, RenderSettings, Renderer, SEGMENT_END, Strategy};
@@ -165,9 +171,85 @@ fn rays(c: &mut Criterion) {
     }
 }
 
+/// The integrator's rays/s over the raw BVH's for the same mix of rays (camera rays, then the shadow rays plain
+/// and skipping their light's convex group), in alternating rounds; prints the median ratio and its range.
+fn ratio_rounds() {
+    const ROUNDS: usize = 31;
+    const SPP: u32 = 32;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
+    for name in ["cornell-box", "veach-mis"] {
+        let scene = load_scene(name).expect("bundled scene loads");
+        let work = workload(&scene);
+        let raw_rate = |skip: bool| {
+            let cpu = ThreadTime::now();
+            let mut n = 0u32;
+            for &(o, d) in &work.primary {
+                n += scene.accel().closest_hit(o, d, f32::INFINITY).is_some() as u32;
+            }
+            for (&(o, d), &group) in work.shadow.iter().zip(&work.skip) {
+                n += scene.accel().occluded(o, d, SEGMENT_END, group.filter(|_| skip)) as u32;
+            }
+            black_box(n);
+            (work.primary.len() + work.shadow.len()) as f64 / cpu.elapsed().as_secs_f64()
+        };
+        let renderer = Renderer::new(&scene, RenderSettings { strategy: Strategy::Emitter, ..Default::default() });
+        let mut film = Film::new(scene.camera.width, scene.camera.height);
+        let mut first = 0;
+        let mut integrator_rate = || {
+            let stats = pool.install(|| renderer.render_pass(&mut film, first, SPP, &|| false));
+            first += SPP;
+            stats.rays as f64 / stats.cpu.as_secs_f64()
+        };
+        integrator_rate(); // warm-up
+        let rounds: Vec<[f64; 3]> = (0..ROUNDS).map(|_| [raw_rate(false), raw_rate(true), integrator_rate()]).collect();
+        let column = |f: &dyn Fn(&[f64; 3]) -> f64| median_and_range(rounds.iter().map(f).collect());
+        let (plain, skipping, integrator) = (column(&|r| r[0]), column(&|r| r[1]), column(&|r| r[2]));
+        let (ratio, ratio_skipping) = (column(&|r| r[2] / r[0]), column(&|r| r[2] / r[1]));
+        println!(
+            "ratio/{name}: {:.3} shadow rays per camera ray; medians of {ROUNDS} rounds: integrator {:.1} M rays/s, \
+             raw single rays {:.1} M/s, skipping {:.1} M/s",
+            work.shadow.len() as f64 / work.primary.len() as f64,
+            integrator.0 / 1e6,
+            plain.0 / 1e6,
+            skipping.0 / 1e6
+        );
+        let percent =
+            |(m, lo, hi): (f64, f64, f64)| format!("{:.1}% ({:.1} … {:.1}%)", 100.0 * m, 100.0 * lo, 100.0 * hi);
+        println!(
+            "ratio/{name}: integrator / raw, median of the rounds' ratios: {}; against the rays skipping: {}",
+            percent(ratio),
+            percent(ratio_skipping)
+        );
+        // Load only ever slows a run down: the fastest of many is the least disturbed.
+        println!(
+            "ratio/{name}: fastest rounds: integrator {:.1} M rays/s, raw {:.1} M/s ({:.1}%), skipping {:.1} M/s ({:.1}%)",
+            integrator.2 / 1e6,
+            plain.2 / 1e6,
+            100.0 * integrator.2 / plain.2,
+            skipping.2 / 1e6,
+            100.0 * integrator.2 / skipping.2
+        );
+    }
+}
+
+/// The median, least and greatest of `v`.
+fn median_and_range(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    (v[v.len() / 2], v[0], v[v.len() - 1])
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20).measurement_time(std::time::Duration::from_secs(3));
     targets = rays
 }
-criterion_main!(benches);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+    // A filter (an argument not starting with '-') picks criterion rows; "ratio" picks the rounds alone.
+    let filters: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
+    if filters.is_empty() || filters.iter().any(|f| f == "ratio") {
+        ratio_rounds();
+    }
+}
