@@ -20,6 +20,11 @@ impl Vec3x8 {
         Self { x: f32x8::splat(v.x), y: f32x8::splat(v.y), z: f32x8::splat(v.z) }
     }
 
+    #[inline(always)]
+    pub fn new(x: f32x8, y: f32x8, z: f32x8) -> Self {
+        Self { x, y, z }
+    }
+
     /// Lane i holds `v[i]`.
     #[inline(always)]
     pub fn from_lanes(v: &[Vec3; 8]) -> Self {

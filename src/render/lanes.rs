@@ -9,7 +9,7 @@
 use super::estimator::{unshadowed, visible_lanes};
 use super::{LightTechnique, ShadingPoint, Target};
 use crate::math::{SampleRng, Vec3x8};
-use crate::scene::{EmitterSampler, Hit, SKIP_NONE, Scene};
+use crate::scene::{EmitterSampler, EmitterTriangle, Hit, SKIP_NONE, Scene};
 use glam::{Vec2, Vec3};
 use wide::{CmpGt, CmpLt, f32x8};
 
@@ -28,51 +28,64 @@ pub fn estimate_emitter_lanes(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir.
-    let mut corners = [[Vec3::ZERO; LANES]; 3];
-    let (mut normal, mut barycentric) = ([Vec3::X; LANES], [Vec2::ZERO; LANES]);
+    // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir. Each
+    // lane's triangle and (u, v) as two rows of eight, transposed into one vector per component.
+    let mut rows = [[f32x8::ZERO; LANES]; 2];
     for (l, hit) in hits.iter().enumerate() {
         if let Some(hit) = hit {
             let tri = &scene.triangles[hit.triangle as usize];
-            (0..3).for_each(|k| corners[k][l] = tri.v[k]);
-            (normal[l], barycentric[l]) = (tri.n, Vec2::new(hit.u, hit.v));
+            let ([a, b, c], n) = (tri.v, tri.n);
+            rows[0][l] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
+            rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, hit.u, hit.v, 0.0, 0.0]);
         }
     }
-    let [a, b, c] = corners.map(|v| Vec3x8::from_lanes(&v));
-    let (u, v) = (f32x8::new(barycentric.map(|b| b.x)), f32x8::new(barycentric.map(|b| b.y)));
+    let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows[0]);
+    let [cz, nx, ny, nz, u, v, _, _] = f32x8::transpose(rows[1]);
+    let (a, b, c) = (Vec3x8::new(ax, ay, az), Vec3x8::new(bx, by, bz), Vec3x8::new(cx, cy, cz));
     let p = a + (b - a) * u + (c - a) * v;
     let wo = -*dirs;
-    let geometric = Vec3x8::from_lanes(&normal);
+    let geometric = Vec3x8::new(nx, ny, nz);
     let facing = geometric.dot(wo);
     let n = Vec3x8::select(facing.cmp_lt(f32x8::ZERO), -geometric, geometric);
     let front = facing.cmp_gt(f32x8::ZERO).move_mask();
 
-    // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ.
-    let mut light = [[Vec3::ZERO; LANES]; 4]; // v₀, v₁, v₂, n_Δ
-    let (mut p_delta, mut area, mut uv) = ([0.0; LANES], [1.0; LANES], [Vec2::ZERO; LANES]);
-    // The picked triangle's material (u32::MAX for none) and convex emitter group.
-    let mut light_material = [u32::MAX; LANES];
-    let mut light_group = [SKIP_NONE; LANES];
+    // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
+    // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
+    // The records are read once every lane has picked, so that their loads wait on the alias table together.
+    let none = EmitterTriangle::NONE.rows();
+    let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
+    let mut picked: [Option<&EmitterTriangle>; LANES] = [None; LANES];
+    let mut uv = [Vec2::ZERO; LANES];
     for (l, hit) in hits.iter().enumerate() {
         if hit.is_none() {
             continue;
         }
         let u = rngs[l].uniform();
-        let (v, n_delta, a, pd, material, group) = match emitters.pick_fixed(u) {
-            Some(e) => (e.v, e.n, e.area, e.p_delta, e.material, e.convex_group),
-            None => {
-                let Some((t, pd)) = emitters.pick(scene, p.lane(l), u) else { continue };
-                let tri = &scene.triangles[t as usize];
-                (tri.v, tri.n, tri.area, pd, tri.material, scene.convex_group(t).unwrap_or(SKIP_NONE))
-            }
-        };
-        // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not has drawn two uniforms
-        // more than the one-sample estimator, which no later step of its sample reads.
-        (0..3).for_each(|k| light[k][l] = v[k]);
-        (light[3][l], area[l], p_delta[l], light_material[l], light_group[l]) = (n_delta, a, pd, material, group);
+        // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not, or that picked no
+        // light, has drawn two uniforms more than the one-sample estimator, which no later step of its sample reads.
         uv[l] = rngs[l].uniform_2d();
+        picked[l] = emitters.pick_fixed(u);
+        if picked[l].is_none()
+            && let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u)
+        {
+            let tri = &scene.triangles[t as usize];
+            let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
+            let (v, n, area, material) = (tri.v, tri.n, tri.area, tri.material);
+            [lo[l], hi[l]] = EmitterTriangle { v, n, area, p_delta, material, convex_group }.rows();
+        }
     }
-    let [la, lb, lc, ln] = light.map(|v| Vec3x8::from_lanes(&v));
+    for (l, e) in picked.iter().enumerate() {
+        if let Some(e) = e {
+            [lo[l], hi[l]] = e.rows();
+        }
+    }
+    let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(lo);
+    let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
+    let (la, lb, lc) = (Vec3x8::new(ax, ay, az), Vec3x8::new(bx, by, bz), Vec3x8::new(cx, cy, cz));
+    let ln = Vec3x8::new(nx, ny, nz);
+    // The picked triangle's material (u32::MAX for none) and convex emitter group.
+    let light_material = material.to_array().map(f32::to_bits);
+    let light_group = group.to_array().map(f32::to_bits);
     // sample_uniform_triangle, then the density p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|), as `emitter::sample` computes them.
     let su0 = f32x8::new(uv.map(|u| u.x)).sqrt();
     let b0 = f32x8::ONE - su0;
@@ -82,7 +95,7 @@ pub fn estimate_emitter_lanes(
     let dist = d.length();
     let wi = d / dist;
     let cos_light = ln.dot(-wi);
-    let pdf = f32x8::new(p_delta) * (dist * dist / (f32x8::new(area) * cos_light));
+    let pdf = p_delta * (dist * dist / (area * cos_light));
     let cos = n.dot(wi);
     // `faces`: p on the emitting side of Δ's plane (else L_i = 0, the back of a one-sided emitter).
     let faces = ln.dot(p - la).cmp_gt(f32x8::ZERO);

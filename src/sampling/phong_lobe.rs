@@ -30,7 +30,9 @@ pub fn phong_lobe_pdf(cos_theta_r: f32, alpha: f32) -> f32 {
 /// cancel): `cos^α θ_r = exp(α ln(1 − g))`. Accurate where ω·ω_r rounds to 1 (α ≳ 10⁵).
 #[inline]
 pub fn phong_lobe_pdf_from_gap(gap: f32, alpha: f32) -> f32 {
-    if gap >= 1.0 {
+    // ln(1 − g) ≤ −g, so α g > 110 puts α ln(1 − g) below −110, rounding errors and all, where exp is 0 in f32
+    // (below −103.98): the same 0 without the two calls, for most directions off a narrow lobe.
+    if gap >= 1.0 || alpha * gap > 110.0 {
         return 0.0;
     }
     let log_cos = (-gap).ln_1p();
@@ -50,6 +52,19 @@ mod tests {
                 let gap = (w - Vec3::Z).length_squared() * 0.5;
                 let p = phong_lobe_pdf_from_gap(gap, alpha);
                 assert!(p.is_finite() && p >= 0.0);
+            }
+        }
+    }
+
+    /// The shortcut for α g > 110 returns what the formula gives, bit for bit, on both sides of it.
+    #[test]
+    fn narrow_lobe_shortcut_changes_nothing() {
+        for alpha in [1.0f32, 111.0, 1e3, 1e4, 1e6] {
+            for k in 0..=4000 {
+                let gap = (110.0 / alpha) * (0.5 + k as f32 / 2000.0);
+                let formula = (alpha + 1.0) * (0.5 / PI) * (alpha * (-gap).ln_1p()).exp();
+                let value = if gap >= 1.0 { 0.0 } else { formula };
+                assert_eq!(phong_lobe_pdf_from_gap(gap, alpha).to_bits(), value.to_bits(), "α {alpha}, g {gap}");
             }
         }
     }

@@ -4,6 +4,7 @@ use super::{SKIP_NONE, Scene};
 use crate::math::luminance;
 use crate::sampling::DiscreteDistribution;
 use glam::Vec3;
+use wide::f32x8;
 
 /// How p_Δ is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -68,6 +69,30 @@ pub struct EmitterTriangle {
     pub material: u32,
     /// [`Scene::convex_group`] of the triangle, or [`SKIP_NONE`] (an `Option` would not fit the cache line).
     pub convex_group: u32,
+}
+
+impl EmitterTriangle {
+    /// What an eight-lane estimator reads for a lane with no light: no material, no group, p_Δ = 0.
+    pub const NONE: Self = Self {
+        v: [Vec3::ZERO; 3],
+        n: Vec3::ZERO,
+        area: 1.0,
+        p_delta: 0.0,
+        material: u32::MAX,
+        convex_group: SKIP_NONE,
+    };
+
+    /// The record as two rows of eight, in field order (`v₀ v₁ v₂.xy`, then `v₂.z n_Δ A_Δ p_Δ material group`,
+    /// the last two as bits): eight records' rows transpose (`f32x8::transpose`) into one vector per field.
+    #[inline(always)]
+    pub fn rows(&self) -> [f32x8; 2] {
+        let ([a, b, c], n) = (self.v, self.n);
+        let (material, group) = (f32::from_bits(self.material), f32::from_bits(self.convex_group));
+        [
+            f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]),
+            f32x8::new([c.z, n.x, n.y, n.z, self.area, self.p_delta, material, group]),
+        ]
+    }
 }
 
 impl EmitterSampler {
