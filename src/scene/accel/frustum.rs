@@ -70,8 +70,7 @@ impl ConeCandidates {
     /// set): lane i gets direction i's hit, bit for bit.
     #[inline]
     pub fn closest_hits(&self, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<Hit>; 8] {
-        let hits = self.packet.closest_of_rays(self.apex, dirs, active, t_max);
-        hits.map(|h| h.map(|h| Hit { triangle: self.packet.ids[h.lane], t: h.t, u: h.u, v: h.v }))
+        self.packet.closest_of_rays(self.apex, dirs, active, t_max)
     }
 }
 

@@ -4,6 +4,7 @@
 //! `t = (e₂·Q)/det` with barycentrics `u = (T·P)/det`, `v = (d·Q)/det`, inside the triangle when
 //! `u ≥ 0, v ≥ 0, u + v ≤ 1`. Both faces are hit.
 
+use super::Hit;
 use super::ray::{RayLanes, WideRay};
 use crate::math::Vec3x8;
 use glam::Vec3;
@@ -111,10 +112,11 @@ impl TrianglePacket {
     }
 
     /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
-    /// `active`, all bits set): lane i gets the hit [`TrianglePacket::closest`] finds for ray i, bit for bit, as the same
-    /// (triangle, ray) pairs go through the same arithmetic; only the roles of the lanes are swapped.
+    /// `active`, all bits set), with the packet's triangle ids: lane i gets the hit [`TrianglePacket::closest`] finds
+    /// for ray i, bit for bit, as the same (triangle, ray) pairs go through the same arithmetic; only the roles of the
+    /// lanes are swapped.
     #[inline(always)]
-    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<LaneHit>; 8] {
+    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<Hit>; 8] {
         let o = origin.to_array().map(f32x8::splat);
         let d = [dirs.x, dirs.y, dirs.z];
         let mut best_t = f32x8::splat(t_max);
@@ -137,7 +139,7 @@ impl TrianglePacket {
             while bits != 0 {
                 let i = bits.trailing_zeros() as usize;
                 bits &= bits - 1;
-                hits[i] = Some(LaneHit { lane: k, t: t[i], u: u[i], v: v[i] });
+                hits[i] = Some(Hit { triangle: self.ids[k], t: t[i], u: u[i], v: v[i] });
             }
         }
         hits
