@@ -34,12 +34,8 @@ pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
     let input: Vec<ObvhsTriangle> =
         positions.iter().map(|[a, b, c]| ObvhsTriangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect();
     let bvh = build_bvh2_from_tris(&input, BvhBuildParams::medium_build(), &mut Duration::default());
-    let groups = groups
-        .iter()
-        .map(|g| {
-            g.map_or(NO_GROUP, |g| i32::try_from(g).ok().filter(|&g| g < i32::MAX - 1).expect("group id below 2³¹ − 2"))
-        })
-        .collect();
+    // Group ids are non-negative as i32; NO_GROUP and SKIP_NOTHING are negative.
+    let groups = groups.iter().map(|g| g.map_or(NO_GROUP, |g| i32::try_from(g).expect("group id below 2³¹"))).collect();
     let mut builder =
         Builder { bvh: &bvh, positions, groups, nodes: vec![], child_groups: vec![], packets: vec![], order: vec![] };
     let (root, _) = builder.child(0, 0);

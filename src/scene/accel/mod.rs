@@ -43,9 +43,9 @@ pub struct Hit {
 
 impl Accel {
     /// Builds the BVH; returns it with the permutation `order[i]` = input index of the i-th stored triangle.
-    /// `groups[i]` is the group of input triangle i (below 2³¹ − 2), if any: an any-hit query may skip one group, and does not
-    /// enter the subtrees that hold only its triangles (the build does not mix groups on purpose: it keeps them
-    /// apart where they lie apart, e.g. one light's triangles from the rest).
+    /// `groups[i]` is the group of input triangle i (below 2³¹), if any: an any-hit query may skip one group,
+    /// and does not enter the subtrees that hold only its triangles (the build does not mix groups on purpose:
+    /// it keeps them apart where they lie apart, e.g. one light's triangles from the rest).
     pub fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> (Self, Vec<u32>) {
         assert_eq!(positions.len(), groups.len(), "one group (or none) per triangle");
         if positions.is_empty() {
@@ -54,9 +54,7 @@ impl Accel {
         let built = build::build(positions, groups);
         (Self { nodes: built.nodes, groups: built.groups, packets: built.packets, root: Some(built.root) }, built.order)
     }
-}
 
-impl Accel {
     /// The groups (see [`Accel::build`]) that some subtree holds apart: the only ones worth skipping.
     pub fn groups_held_apart(&self) -> Vec<u32> {
         let mut groups: Vec<u32> = self.groups.iter().flat_map(ChildGroups::groups).collect();
@@ -205,8 +203,8 @@ mod tests {
 
     /// Eight rays walking the BVH together, one per lane, answer as each does alone, bit for bit: bundles from
     /// nearby origins towards one region (as a pixel's shadow rays) and bundles of unrelated rays, with some
-    /// lanes inactive and each lane skipping a group or none, on soups of every size (where fewer than five rays enter a subtree, they walk it alone,
-    /// interleaved).
+    /// lanes inactive and each lane skipping a group or none, on soups of every size (where fewer than five rays
+    /// enter a subtree, they walk it alone, interleaved).
     #[test]
     fn eight_rays_together_answer_as_each_alone() {
         let mut occluded = 0;
