@@ -19,8 +19,33 @@ pub fn reflect(w: glam::Vec3, n: glam::Vec3) -> glam::Vec3 {
     2.0 * n.dot(w) * n - w
 }
 
+/// Calls `f` with the index of each set bit of a lane mask (bit i for lane i), lowest first: a loop over the
+/// lanes that go on, where a branch per lane would be mispredicted when which lanes go on varies at random.
+#[inline(always)]
+pub fn for_each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
+    while bits != 0 {
+        f(bits.trailing_zeros() as usize);
+        bits &= bits - 1;
+    }
+}
+
 /// Luminance of a linear Rec. 709 / sRGB colour (ITU-R BT.709 weights).
 #[inline]
 pub fn luminance(c: glam::Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn for_each_lane_visits_the_set_bits_in_order() {
+        for bits in [0u32, 1, 0b1010_0110, 0xff, 1 << 31] {
+            let mut seen = Vec::new();
+            for_each_lane(bits, |l| seen.push(l));
+            let expected: Vec<usize> = (0..32).filter(|&l| bits & (1 << l) != 0).collect();
+            assert_eq!(seen, expected, "bits {bits:#b}");
+        }
+    }
 }

@@ -8,46 +8,51 @@
 
 use super::estimator::{unshadowed, visible_lanes};
 use super::{LightTechnique, ShadingPoint, Target};
-use crate::math::{SampleRng, Vec3x8};
-use crate::scene::{EmitterSampler, EmitterTriangle, Hit, SKIP_NONE, Scene};
+use crate::math::{SampleRng, Vec3x8, for_each_lane};
+use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
 use glam::{Vec2, Vec3};
 use wide::{CmpGt, CmpLt, f32x8};
 
 /// Samples per group.
 pub const LANES: usize = 8;
 
-/// `L_e(x, ω_o) + f_r L_i (ω·n) / p(ω)` for up to eight camera rays `dirs` of one pixel and their hits (`None`
-/// for a lane that missed or is unused), with ω from emitter sampling. Each lane's stream `rngs[l]` continues
+/// `L_e(x, ω_o) + f_r L_i (ω·n) / p(ω)` for up to eight camera rays `dirs` of one pixel and their hits (none
+/// in a lane that missed or is unused), with ω from emitter sampling. Each lane's stream `rngs[l]` continues
 /// after the camera's two uniforms. Adds the shadow rays traced to `rays`.
 #[inline]
 pub fn estimate_emitter_lanes(
     scene: &Scene,
     emitters: &EmitterSampler,
     dirs: &Vec3x8,
-    hits: &[Option<Hit>; LANES],
+    hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
+    // The lanes are visited through the bits of masks such as `hit_lanes`: whether a lane goes on varies from
+    // sample to sample (half of veach-mis's samples pick the back of a sphere), and a branch per lane would be
+    // mispredicted.
+    let hit_lanes = hits.mask;
     // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir. Each
-    // lane's triangle and (u, v) as two rows of eight, transposed into one vector per component.
+    // lane's triangle as two rows of eight, transposed into one vector per component; (u, v) come as vectors.
     let mut rows = [[f32x8::ZERO; LANES]; 2];
-    for (l, hit) in hits.iter().enumerate() {
-        if let Some(hit) = hit {
-            let tri = &scene.triangles[hit.triangle as usize];
-            let ([a, b, c], n) = (tri.v, tri.n);
-            rows[0][l] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
-            rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, hit.u, hit.v, 0.0, 0.0]);
-        }
-    }
+    let mut materials = [0; LANES];
+    for_each_lane(hit_lanes, |l| {
+        let tri = &scene.triangles[hits.triangle[l] as usize];
+        let ([a, b, c], n) = (tri.v, tri.n);
+        rows[0][l] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
+        rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, 0.0, 0.0, 0.0, 0.0]);
+        materials[l] = tri.material;
+    });
     let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows[0]);
-    let [cz, nx, ny, nz, u, v, _, _] = f32x8::transpose(rows[1]);
+    let [cz, nx, ny, nz, _, _, _, _] = f32x8::transpose(rows[1]);
+    let (u, v) = (hits.u, hits.v);
     let (a, b, c) = (Vec3x8::new(ax, ay, az), Vec3x8::new(bx, by, bz), Vec3x8::new(cx, cy, cz));
     let p = a + (b - a) * u + (c - a) * v;
     let wo = -*dirs;
     let geometric = Vec3x8::new(nx, ny, nz);
     let facing = geometric.dot(wo);
     let n = Vec3x8::select(facing.cmp_lt(f32x8::ZERO), -geometric, geometric);
-    let front = facing.cmp_gt(f32x8::ZERO).move_mask();
+    let front = facing.cmp_gt(f32x8::ZERO).move_mask() as u32;
 
     // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
     // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
@@ -56,24 +61,23 @@ pub fn estimate_emitter_lanes(
     let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
     let mut picked: [Option<&EmitterTriangle>; LANES] = [None; LANES];
     let mut uv = [Vec2::ZERO; LANES];
-    for (l, hit) in hits.iter().enumerate() {
-        if hit.is_none() {
-            continue;
-        }
+    let mut picked_lanes = 0;
+    for_each_lane(hit_lanes, |l| {
         let u = rngs[l].uniform();
         // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not, or that picked no
         // light, has drawn two uniforms more than the one-sample estimator, which no later step of its sample reads.
         uv[l] = rngs[l].uniform_2d();
         picked[l] = emitters.pick_fixed(u);
-        if picked[l].is_none()
-            && let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u)
-        {
+        if picked[l].is_some() {
+            picked_lanes |= 1 << l;
+        } else if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u) {
             let tri = &scene.triangles[t as usize];
             let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
             let (v, n, area, material) = (tri.v, tri.n, tri.area, tri.material);
             [lo[l], hi[l]] = EmitterTriangle { v, n, area, p_delta, material, convex_group }.rows();
+            picked_lanes |= 1 << l;
         }
-    }
+    });
     for (l, e) in picked.iter().enumerate() {
         if let Some(e) = e {
             [lo[l], hi[l]] = e.rows();
@@ -105,22 +109,16 @@ pub fn estimate_emitter_lanes(
         & pdf.cmp_gt(f32x8::ZERO)
         & pdf.is_finite()
         & cos.cmp_gt(f32x8::ZERO);
-    let ok = ok.move_mask();
+    let ok = ok.move_mask() as u32;
 
     let (pdf, cos) = (pdf.to_array(), cos.to_array());
 
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    for_each_lane(front & hit_lanes, |l| emitted[l] = scene.materials[materials[l] as usize].emission);
     let mut shadow_rays = 0;
-    for (l, hit) in hits.iter().enumerate() {
-        let Some(hit) = hit else { continue };
-        let material = scene.material_of(hit.triangle);
-        if front & (1 << l) != 0 {
-            emitted[l] = material.emission;
-        }
-        if light_material[l] == u32::MAX || ok & (1 << l) == 0 {
-            continue;
-        }
+    for_each_lane(ok & picked_lanes, |l| {
+        let material = &scene.materials[materials[l] as usize];
         let wi = wi.lane(l);
         let f = material.eval_brdf(n.lane(l), wo.lane(l), wi);
         // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`.
@@ -129,7 +127,7 @@ pub fn estimate_emitter_lanes(
             reflected[l] = f * li * cos[l] / pdf[l];
             shadow_rays |= 1 << l;
         }
-    }
+    });
     let visible = visible_lanes(scene, p, n, x, ln, light_group, shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
@@ -143,7 +141,7 @@ pub fn estimate_light_lanes(
     emitters: &EmitterSampler,
     technique: LightTechnique,
     dirs: &Vec3x8,
-    hits: &[Option<Hit>; LANES],
+    hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
@@ -152,11 +150,11 @@ pub fn estimate_light_lanes(
     let mut ends = [[Vec3::ZERO; LANES]; 4];
     let mut groups = [SKIP_NONE; LANES];
     let mut shadow_rays = 0;
-    for (l, hit) in hits.iter().enumerate() {
-        let Some(hit) = hit else { continue };
+    for l in 0..LANES {
+        let Some(hit) = hits.lane(l) else { continue };
         let tri = &scene.triangles[hit.triangle as usize];
         let wo = -dirs.lane(l);
-        let sp = ShadingPoint::new(scene.hit_point(hit), tri.n, wo, scene.material_of(hit.triangle));
+        let sp = ShadingPoint::new(scene.hit_point(&hit), tri.n, wo, scene.material_of(hit.triangle));
         emitted[l] = scene.emitted(hit.triangle, wo);
         let Some(s) = technique.sample(&sp, scene, emitters, &mut rngs[l]) else { continue };
         let Target::Emitter { triangle, point } = s.target else { continue };

@@ -6,7 +6,7 @@ use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
 use super::strategy::MisSettings;
 use super::{Film, LightTechnique, PixelAccum, ShadingPoint, Strategy, estimate_direct};
 use crate::math::{PixelStreams, SampleRng};
-use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, LightSelection, Scene};
+use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -175,11 +175,11 @@ impl<'a> Renderer<'a> {
                 let active = f32x8::new(std::array::from_fn(|l| if l < n { f32::from_bits(u32::MAX) } else { 0.0 }));
                 cone.closest_hits(&dirs, active, f32::INFINITY)
             }
-            None => std::array::from_fn(|l| {
+            None => HitLanes::from_hits(&std::array::from_fn(|l| {
                 (l < n)
                     .then(|| self.scene.accel().closest_hit(self.camera.eye(), dirs.lane(l), f32::INFINITY))
                     .flatten()
-            }),
+            })),
         };
         *rays += n as u64;
         match (self.settings.strategy.light_technique(), &self.emitters) {
@@ -190,7 +190,7 @@ impl<'a> Renderer<'a> {
                 estimate_light_lanes(self.scene, emitters, technique, &dirs, &hits, &mut rngs, rays)
             }
             _ => std::array::from_fn(|l| {
-                hits[l].map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs[l], rays))
+                hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs[l], rays))
             }),
         }
     }

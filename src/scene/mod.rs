@@ -11,7 +11,7 @@ mod file;
 mod load;
 mod material;
 
-pub use accel::{Accel, ConeCandidates, Hit, SKIP_NONE};
+pub use accel::{Accel, ConeCandidates, Hit, HitLanes, SKIP_NONE};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};

@@ -9,7 +9,7 @@ use super::node::Child;
 use super::packet::TrianglePacket;
 use super::ray::WideRay;
 use super::traverse::STACK;
-use super::{Accel, Hit};
+use super::{Accel, Hit, HitLanes};
 use crate::math::Vec3x8;
 use arrayvec::ArrayVec;
 use glam::Vec3;
@@ -69,7 +69,7 @@ impl ConeCandidates {
     /// [`ConeCandidates::closest_hit`] for eight directions at once (one per lane; those in `active`, all bits
     /// set): lane i gets direction i's hit, bit for bit.
     #[inline]
-    pub fn closest_hits(&self, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<Hit>; 8] {
+    pub fn closest_hits(&self, dirs: &Vec3x8, active: f32x8, t_max: f32) -> HitLanes {
         self.packet.closest_of_rays(self.apex, dirs, active, t_max)
     }
 }
@@ -110,7 +110,7 @@ mod tests {
                         assert_eq!(dirs.lane(l).to_array().map(f32::to_bits), dir.to_array().map(f32::to_bits));
                         let alone = cone.closest_hit(dir, f32::INFINITY);
                         let key = |h: Option<Hit>| h.map(|h| (h.triangle, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
-                        assert_eq!(key(lanes[l]), key(alone), "{name} pixel ({x}, {y}), lane {l}");
+                        assert_eq!(key(lanes.lane(l)), key(alone), "{name} pixel ({x}, {y}), lane {l}");
                     }
                     let jitters = corners.into_iter().map(Vec2::from).chain(random);
                     for jitter in jitters.collect::<Vec<_>>() {

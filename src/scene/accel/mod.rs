@@ -15,6 +15,7 @@ pub use frustum::ConeCandidates;
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;
+use wide::f32x8;
 
 /// Acceleration structure over the scene's triangles, stored in the BVH's leaf order so that a hit's triangle
 /// index is the position in that order.
@@ -39,6 +40,45 @@ pub struct Hit {
     pub t: f32,
     pub u: f32,
     pub v: f32,
+}
+
+/// The closest hits of eight rays, one per lane, as vectors: what eight-lane code reads of them without
+/// scattering and gathering per-lane [`Hit`]s.
+#[derive(Clone, Copy, Debug)]
+pub struct HitLanes {
+    /// Bit i set where ray i hit something.
+    pub mask: u32,
+    /// The triangle each ray hit ([`u32::MAX`] where none).
+    pub triangle: [u32; 8],
+    /// The [`Hit`] fields, lane by lane; meaningless in lanes outside `mask`.
+    pub t: f32x8,
+    pub u: f32x8,
+    pub v: f32x8,
+}
+
+impl HitLanes {
+    /// Lane i holds `hits[i]`.
+    pub fn from_hits(hits: &[Option<Hit>; 8]) -> Self {
+        let field = |f: fn(&Hit) -> f32| f32x8::new(hits.map(|h| h.as_ref().map_or(0.0, f)));
+        Self {
+            mask: hits.iter().enumerate().fold(0, |m, (l, h)| m | (h.is_some() as u32) << l),
+            triangle: hits.map(|h| h.map_or(u32::MAX, |h| h.triangle)),
+            t: field(|h| h.t),
+            u: field(|h| h.u),
+            v: field(|h| h.v),
+        }
+    }
+
+    /// Lane i's hit.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> Option<Hit> {
+        (self.mask & (1 << i) != 0).then(|| Hit {
+            triangle: self.triangle[i],
+            t: self.t.as_array_ref()[i],
+            u: self.u.as_array_ref()[i],
+            v: self.v.as_array_ref()[i],
+        })
+    }
 }
 
 impl Accel {

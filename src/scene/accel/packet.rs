@@ -4,7 +4,7 @@
 //! `t = (e₂·Q)/det` with barycentrics `u = (T·P)/det`, `v = (d·Q)/det`, inside the triangle when
 //! `u ≥ 0, v ≥ 0, u + v ≤ 1`. Both faces are hit.
 
-use super::Hit;
+use super::HitLanes;
 use super::ray::{RayLanes, WideRay};
 use crate::math::Vec3x8;
 use glam::Vec3;
@@ -114,13 +114,15 @@ impl TrianglePacket {
     /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
     /// `active`, all bits set), with the packet's triangle ids: lane i gets the hit [`TrianglePacket::closest`] finds
     /// for ray i, bit for bit, as the same (triangle, ray) pairs go through the same arithmetic; only the roles of the
-    /// lanes are swapped.
+    /// lanes are swapped. The best hits so far stay in vectors, updated by blends: no branch or store per lane.
     #[inline(always)]
-    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> [Option<Hit>; 8] {
+    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> HitLanes {
         let o = origin.to_array().map(f32x8::splat);
         let d = [dirs.x, dirs.y, dirs.z];
         let mut best_t = f32x8::splat(t_max);
-        let mut hits = [None; 8];
+        let (mut best_u, mut best_v) = (f32x8::ZERO, f32x8::ZERO);
+        // The triangle ids ride in f32 lanes as bits, for the blends.
+        let mut best_id = f32x8::splat(f32::from_bits(u32::MAX));
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
             let (hit, [t, u, v, det]) = self.test_rays(k, &o, &d, t_max);
             let hit = hit & active;
@@ -130,19 +132,14 @@ impl TrianglePacket {
             let inv = f32x8::ONE / det;
             let t = t * inv;
             let nearer = hit & t.cmp_lt(best_t);
-            let mut bits = nearer.move_mask() as u32;
-            if bits == 0 {
-                continue;
-            }
             best_t = nearer.blend(t, best_t);
-            let (t, u, v) = (t.to_array(), (u * inv).to_array(), (v * inv).to_array());
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                hits[i] = Some(Hit { triangle: self.ids[k], t: t[i], u: u[i], v: v[i] });
-            }
+            best_u = nearer.blend(u * inv, best_u);
+            best_v = nearer.blend(v * inv, best_v);
+            best_id = nearer.blend(f32x8::splat(f32::from_bits(self.ids[k])), best_id);
         }
-        hits
+        let triangle = best_id.to_array().map(f32::to_bits);
+        let mask = triangle.iter().enumerate().fold(0, |m, (l, &id)| m | ((id != u32::MAX) as u32) << l);
+        HitLanes { mask, triangle, t: best_t, u: best_u, v: best_v }
     }
 
     /// The rays of `rays` (bit i for lane i) that hit one of the packet's triangles at `0 < t < t_max`: bit i is

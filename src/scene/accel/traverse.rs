@@ -8,7 +8,7 @@ use super::build::MAX_DEPTH;
 use super::node::{Child, SKIP_NOTHING};
 use super::ray::{RayLanes, WideRay};
 use super::{Accel, Hit};
-use crate::math::Vec3x8;
+use crate::math::{Vec3x8, for_each_lane};
 use arrayvec::ArrayVec;
 use glam::Vec3;
 use wide::{CmpEq, i32x8};
@@ -275,12 +275,3 @@ const SET_ASIDE: usize = 8;
 
 /// The stack of a ray's any-hit walk: room for the subtrees set aside and for a walk from one of them.
 type AnyHitStack = ArrayVec<Child, { SET_ASIDE + STACK }>;
-
-/// Calls `f` with each set bit's index, lowest first.
-#[inline(always)]
-fn for_each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
-    while bits != 0 {
-        f(bits.trailing_zeros() as usize);
-        bits &= bits - 1;
-    }
-}
