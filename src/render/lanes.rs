@@ -71,10 +71,7 @@ pub fn estimate_emitter_lanes(
         if picked[l].is_some() {
             picked_lanes |= 1 << l;
         } else if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u) {
-            let tri = &scene.triangles[t as usize];
-            let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
-            let (v, n, area, material) = (tri.v, tri.n, tri.area, tri.material);
-            [lo[l], hi[l]] = EmitterTriangle { v, n, area, p_delta, material, convex_group }.rows();
+            [lo[l], hi[l]] = EmitterTriangle::of(scene, t, p_delta).rows();
             picked_lanes |= 1 << l;
         }
     });

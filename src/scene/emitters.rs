@@ -82,6 +82,14 @@ impl EmitterTriangle {
         convex_group: SKIP_NONE,
     };
 
+    /// The record of the scene's triangle `t`, picked with probability `p_delta`.
+    #[inline(always)]
+    pub fn of(scene: &Scene, t: u32, p_delta: f32) -> Self {
+        let tri = &scene.triangles[t as usize];
+        let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
+        Self { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material, convex_group }
+    }
+
     /// The record as two rows of eight, in field order (`v₀ v₁ v₂.xy`, then `v₂.z n_Δ A_Δ p_Δ material group`,
     /// the last two as bits): eight records' rows transpose (`f32x8::transpose`) into one vector per field.
     #[inline(always)]
@@ -127,12 +135,7 @@ impl EmitterSampler {
         let records = if selection == LightSelection::Contribution {
             Vec::new()
         } else {
-            let record = |(slot, &t): (usize, &u32)| {
-                let tri = &scene.triangles[t as usize];
-                let p_delta = distribution.pmf(slot);
-                let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
-                EmitterTriangle { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material, convex_group }
-            };
+            let record = |(slot, &t): (usize, &u32)| EmitterTriangle::of(scene, t, distribution.pmf(slot));
             scene.emitters.iter().enumerate().map(record).collect()
         };
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records })
