@@ -10,7 +10,7 @@ mod vec3x8;
 pub use frame::Frame;
 pub use offset::{offset_ray_origin, offset_ray_origins};
 pub use polygon::lambert_polygon_irradiance;
-pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng};
+pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes};
 pub use vec3x8::Vec3x8;
 
 /// Reflects `w` about the unit normal `n`: ω_r = 2 (n·ω) n − ω (the lecture's mirror direction).

@@ -2,15 +2,22 @@
 //! seed, whatever the thread count and the order in which passes run.
 
 use glam::Vec2;
-use rand_core::Rng;
-use rand_pcg::Pcg32;
+use wide::f32x8;
 
 /// The largest f32 below one: uniforms live in [0, 1).
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// A PCG32 stream (O'Neill 2014) whose state is a hash of (seed, pixel, sample index), so every pixel sample
-/// has its own independent stream. Dimensions are drawn in a fixed order by each strategy.
-pub struct SampleRng(Pcg32);
+/// A PCG32 stream (O'Neill 2014: PCG-XSH-RR, 64-bit LCG state, 32-bit output, as `rand_pcg::Pcg32`) whose state
+/// is a hash of (seed, pixel, sample index), so every pixel sample has its own independent stream. Dimensions are
+/// drawn in a fixed order by each strategy.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleRng {
+    state: u64,
+    increment: u64,
+}
+
+/// The LCG's multiplier (Knuth's MMIX, as in the PCG reference).
+const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
 
 impl SampleRng {
     #[inline]
@@ -18,16 +25,79 @@ impl SampleRng {
         PixelStreams::new(seed, pixel).sample(sample)
     }
 
+    /// `rand_pcg::Pcg32::new(state, stream)`: the increment is `2·stream + 1`, the state moves off the seed by
+    /// one increment and one step.
+    #[inline(always)]
+    fn pcg32(state: u64, stream: u64) -> Self {
+        let increment = (stream << 1) | 1;
+        Self { state: lcg_step(state.wrapping_add(increment), increment), increment }
+    }
+
+    /// The next 32 random bits: the output permutation of the current state, then one LCG step.
+    #[inline(always)]
+    fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = lcg_step(old, self.increment);
+        xsh_rr(old)
+    }
+
     /// A uniform in [0, 1) with 24 random bits.
     #[inline]
     pub fn uniform(&mut self) -> f32 {
-        (self.0.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+        to_uniform(self.next_u32())
     }
 
     #[inline]
     pub fn uniform_2d(&mut self) -> Vec2 {
         Vec2::new(self.uniform(), self.uniform())
     }
+}
+
+/// Eight [`SampleRng`] streams, one per SIMD lane, drawn together: the same numbers as each stream alone, from
+/// loops the compiler vectorises (the 64-bit products become three 32-bit ones per lane under AVX2).
+#[derive(Clone, Copy, Debug)]
+pub struct SampleRngLanes {
+    state: [u64; 8],
+    increment: u64,
+}
+
+impl SampleRngLanes {
+    /// The next uniform of every stream, lane i from stream i.
+    #[inline(always)]
+    pub fn uniform(&mut self) -> f32x8 {
+        let mut u = [0.0; 8];
+        for (u, state) in u.iter_mut().zip(&mut self.state) {
+            let old = *state;
+            *state = lcg_step(old, self.increment);
+            *u = to_uniform(xsh_rr(old));
+        }
+        f32x8::new(u)
+    }
+
+    /// Stream i, to go on alone.
+    #[inline(always)]
+    pub fn lane(&self, i: usize) -> SampleRng {
+        SampleRng { state: self.state[i], increment: self.increment }
+    }
+}
+
+#[inline(always)]
+fn lcg_step(state: u64, increment: u64) -> u64 {
+    state.wrapping_mul(MULTIPLIER).wrapping_add(increment)
+}
+
+/// PCG's output function XSH RR: an xorshift of the high bits, then a rotation by the top five.
+#[inline(always)]
+fn xsh_rr(state: u64) -> u32 {
+    let rot = (state >> 59) as u32;
+    let xsh = (((state >> 18) ^ state) >> 27) as u32;
+    xsh.rotate_right(rot)
+}
+
+/// The top 24 bits as a uniform in [0, 1).
+#[inline(always)]
+fn to_uniform(bits: u32) -> f32 {
+    (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// The part of every sample stream's key that depends only on (seed, pixel): hashed once per pixel, so each
@@ -51,7 +121,22 @@ impl PixelStreams {
     /// for each pixel (K odd).
     #[inline]
     pub fn sample(&self, sample: u64) -> SampleRng {
-        SampleRng(Pcg32::new(mix64(self.key ^ sample.wrapping_mul(0xd1b5_4a32_d192_ed03)), self.stream))
+        SampleRng::pcg32(self.sample_state(sample), self.stream)
+    }
+
+    /// The streams of samples `first..first + 8`, lane i holding [`PixelStreams::sample`]`(first + i)`.
+    #[inline(always)]
+    pub fn samples(&self, first: u64) -> SampleRngLanes {
+        let increment = (self.stream << 1) | 1;
+        let state = std::array::from_fn(|i| {
+            lcg_step(self.sample_state(first.wrapping_add(i as u64)).wrapping_add(increment), increment)
+        });
+        SampleRngLanes { state, increment }
+    }
+
+    #[inline(always)]
+    fn sample_state(&self, sample: u64) -> u64 {
+        mix64(self.key ^ sample.wrapping_mul(0xd1b5_4a32_d192_ed03))
     }
 }
 
@@ -89,5 +174,30 @@ mod tests {
             assert!((mean - 0.5).abs() < 4.6e-3, "{mean}");
         }
         assert_eq!(pixel.sample(7).uniform(), SampleRng::new(1, 12_345, 7).uniform());
+    }
+
+    /// The streams are `rand_pcg::Pcg32`'s, number for number: alone, eight at a time, and alone again after
+    /// drawing eight at a time.
+    #[test]
+    fn streams_are_rand_pcgs_pcg32() {
+        use rand_core::Rng;
+        for (seed, pixel) in [(0, 0), (1, 12_345), (u64::MAX, 7)] {
+            let streams = PixelStreams::new(seed, pixel);
+            for first in [0, 5, u64::MAX - 3] {
+                let mut lanes = streams.samples(first);
+                let together: Vec<[f32; 8]> = (0..10).map(|_| lanes.uniform().to_array()).collect();
+                for i in 0..8 {
+                    let sample = first.wrapping_add(i as u64);
+                    let mut reference = rand_pcg::Pcg32::new(streams.sample_state(sample), streams.stream);
+                    let (mut alone, mut after) = (streams.sample(sample), lanes.lane(i));
+                    for draw in 0..20 {
+                        let want = (reference.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
+                        assert_eq!(alone.uniform(), want);
+                        let got = if draw < 10 { together[draw][i] } else { after.uniform() };
+                        assert_eq!(got, want, "seed {seed}, pixel {pixel}, sample {first} + {i}, draw {draw}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -8,24 +8,24 @@
 
 use super::estimator::{unshadowed, visible_lanes};
 use super::{LightTechnique, ShadingPoint, Target};
-use crate::math::{SampleRng, Vec3x8, for_each_lane};
+use crate::math::{SampleRng, SampleRngLanes, Vec3x8, for_each_lane};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use wide::{CmpGt, CmpLt, f32x8};
 
 /// Samples per group.
 pub const LANES: usize = 8;
 
 /// `L_e(x, ω_o) + f_r L_i (ω·n) / p(ω)` for up to eight camera rays `dirs` of one pixel and their hits (none
-/// in a lane that missed or is unused), with ω from emitter sampling. Each lane's stream `rngs[l]` continues
-/// after the camera's two uniforms. Adds the shadow rays traced to `rays`.
+/// in a lane that missed or is unused), with ω from emitter sampling. Lane l of `rngs` continues sample l's
+/// stream after the camera's two uniforms. Adds the shadow rays traced to `rays`.
 #[inline]
 pub fn estimate_emitter_lanes(
     scene: &Scene,
     emitters: &EmitterSampler,
     dirs: &Vec3x8,
     hits: &HitLanes,
-    rngs: &mut [SampleRng; LANES],
+    rngs: &mut SampleRngLanes,
     rays: &mut u64,
 ) -> [Vec3; LANES] {
     // The lanes are visited through the bits of masks such as `hit_lanes`: whether a lane goes on varies from
@@ -60,13 +60,13 @@ pub fn estimate_emitter_lanes(
     let none = EmitterTriangle::NONE.rows();
     let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
     let mut picked: [Option<&EmitterTriangle>; LANES] = [None; LANES];
-    let mut uv = [Vec2::ZERO; LANES];
+    // Every lane draws the light's uniform and the point's two, used or not: whether p faces Δ is tested for all
+    // lanes below (`faces`), and a lane that does not, or that picked no light, or missed, reads none of them
+    // after the one-sample estimator would have stopped.
+    let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
     let mut picked_lanes = 0;
     for_each_lane(hit_lanes, |l| {
-        let u = rngs[l].uniform();
-        // Whether p faces Δ is tested for all lanes below (`faces`); a lane that does not, or that picked no
-        // light, has drawn two uniforms more than the one-sample estimator, which no later step of its sample reads.
-        uv[l] = rngs[l].uniform_2d();
+        let u = u_light[l];
         picked[l] = emitters.pick_fixed(u);
         if picked[l].is_some() {
             picked_lanes |= 1 << l;
@@ -88,9 +88,9 @@ pub fn estimate_emitter_lanes(
     let light_material = material.to_array().map(f32::to_bits);
     let light_group = group.to_array().map(f32::to_bits);
     // sample_uniform_triangle, then the density p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|), as `emitter::sample` computes them.
-    let su0 = f32x8::new(uv.map(|u| u.x)).sqrt();
+    let su0 = u_point[0].sqrt();
     let b0 = f32x8::ONE - su0;
-    let b1 = f32x8::new(uv.map(|u| u.y)) * su0;
+    let b1 = u_point[1] * su0;
     let x = la * b0 + lb * b1 + lc * (f32x8::ONE - b0 - b1);
     let d = x - p;
     let dist = d.length();

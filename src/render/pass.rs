@@ -167,9 +167,9 @@ impl<'a> Renderer<'a> {
         rays: &mut u64,
     ) -> [Vec3; LANES] {
         let n = samples.len();
-        let mut rngs: [SampleRng; LANES] = std::array::from_fn(|l| streams.sample((samples.start + l as u32) as u64));
-        let jitter = std::array::from_fn(|l| rngs[l].uniform_2d());
-        let dirs = self.camera.directions(x, y, &jitter);
+        let mut rngs = streams.samples(samples.start as u64);
+        let (jitter_x, jitter_y) = (rngs.uniform(), rngs.uniform());
+        let dirs = self.camera.directions(x, y, jitter_x, jitter_y);
         let hits = match cone {
             Some(cone) => {
                 let active = f32x8::new(std::array::from_fn(|l| if l < n { f32::from_bits(u32::MAX) } else { 0.0 }));
@@ -187,10 +187,11 @@ impl<'a> Renderer<'a> {
                 estimate_emitter_lanes(self.scene, emitters, &dirs, &hits, &mut rngs, rays)
             }
             (Some(technique), Some(emitters)) => {
+                let mut rngs = std::array::from_fn(|l| rngs.lane(l));
                 estimate_light_lanes(self.scene, emitters, technique, &dirs, &hits, &mut rngs, rays)
             }
             _ => std::array::from_fn(|l| {
-                hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs[l], rays))
+                hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays))
             }),
         }
     }

@@ -77,14 +77,15 @@ impl CameraBasis {
         (self.forward + self.right * ndc.x - self.up * ndc.y).normalize()
     }
 
-    /// [`CameraBasis::direction`] for eight jitters at once, one per lane, each equal to the scalar one bit for bit.
+    /// [`CameraBasis::direction`] for eight jitters `(jitter_x, jitter_y)` at once, one per lane, each equal to the
+    /// scalar one bit for bit.
     #[inline]
-    pub fn directions(&self, x: u32, y: u32, jitter: &[Vec2; 8]) -> Vec3x8 {
+    pub fn directions(&self, x: u32, y: u32, jitter_x: f32x8, jitter_y: f32x8) -> Vec3x8 {
         let ndc = |pixel: u32, jitter: f32x8, inv_size: f32| {
             (f32x8::splat(pixel as f32) + jitter) * f32x8::splat(inv_size) * f32x8::splat(2.0) - f32x8::ONE
         };
-        let ndc_x = ndc(x, f32x8::new(jitter.map(|j| j.x)), self.inv_size.x);
-        let ndc_y = ndc(y, f32x8::new(jitter.map(|j| j.y)), self.inv_size.y);
+        let ndc_x = ndc(x, jitter_x, self.inv_size.x);
+        let ndc_y = ndc(y, jitter_y, self.inv_size.y);
         (Vec3x8::splat(self.forward) + Vec3x8::splat(self.right) * ndc_x - Vec3x8::splat(self.up) * ndc_y).normalize()
     }
 

@@ -103,7 +103,7 @@ mod tests {
                     ];
                     let random: [Vec2; 8] = std::array::from_fn(|_| rng.uniform_2d());
                     // Eight directions at once, and their hits through the cone, lane by lane as alone.
-                    let dirs = basis.directions(x, y, &random);
+                    let dirs = basis.directions(x, y, f32x8::new(random.map(|j| j.x)), f32x8::new(random.map(|j| j.y)));
                     let lanes = cone.closest_hits(&dirs, f32x8::splat(f32::from_bits(u32::MAX)), f32::INFINITY);
                     for (l, jitter) in random.iter().enumerate() {
                         let dir = basis.direction(x, y, *jitter);
