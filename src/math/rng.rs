@@ -190,10 +190,11 @@ mod tests {
                     let sample = first.wrapping_add(i as u64);
                     let mut reference = rand_pcg::Pcg32::new(streams.sample_state(sample), streams.stream);
                     let (mut alone, mut after) = (streams.sample(sample), lanes.lane(i));
+                    let mut drawn = together.iter().map(|u| u[i]).chain(std::iter::repeat_with(|| after.uniform()));
                     for draw in 0..20 {
                         let want = (reference.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
                         assert_eq!(alone.uniform(), want);
-                        let got = if draw < 10 { together[draw][i] } else { after.uniform() };
+                        let got = drawn.next().expect("endless");
                         assert_eq!(got, want, "seed {seed}, pixel {pixel}, sample {first} + {i}, draw {draw}");
                     }
                 }
