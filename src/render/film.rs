@@ -17,11 +17,11 @@ pub struct PixelAccum {
 impl PixelAccum {
     #[inline]
     pub fn add(&mut self, v: Vec3) {
-        let v = v.as_dvec3();
-        self.sum += v;
-        self.sum_sq += v * v;
+        let d = v.as_dvec3();
+        self.sum += d;
+        self.sum_sq += d * d;
         self.n += 1;
-        self.max_luminance = self.max_luminance.max(luminance(v.as_vec3()));
+        self.max_luminance = self.max_luminance.max(luminance(v));
     }
 
     /// Adds the samples accumulated in `other`.

@@ -59,26 +59,21 @@ pub fn estimate_emitter_lanes(
     // The records are read once every lane has picked, so that their loads wait on the alias table together.
     let none = EmitterTriangle::NONE.rows();
     let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
-    let mut picked: [Option<&EmitterTriangle>; LANES] = [None; LANES];
     // Every lane draws the light's uniform and the point's two, used or not: whether p faces Δ is tested for all
     // lanes below (`faces`), and a lane that does not, or that picked no light, or missed, reads none of them
     // after the one-sample estimator would have stopped.
     let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
     let mut picked_lanes = 0;
-    for_each_lane(hit_lanes, |l| {
-        let u = u_light[l];
-        picked[l] = emitters.pick_fixed(u);
-        if picked[l].is_some() {
-            picked_lanes |= 1 << l;
-        } else if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u) {
-            [lo[l], hi[l]] = EmitterTriangle::of(scene, t, p_delta).rows();
-            picked_lanes |= 1 << l;
-        }
-    });
-    for (l, e) in picked.iter().enumerate() {
-        if let Some(e) = e {
-            [lo[l], hi[l]] = e.rows();
-        }
+    if let Some(records) = emitters.pick_fixed_lanes(u_light) {
+        for_each_lane(hit_lanes, |l| [lo[l], hi[l]] = records[l].rows());
+        picked_lanes = hit_lanes;
+    } else {
+        for_each_lane(hit_lanes, |l| {
+            if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
+                [lo[l], hi[l]] = EmitterTriangle::of(scene, t, p_delta).rows();
+                picked_lanes |= 1 << l;
+            }
+        });
     }
     let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(lo);
     let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);

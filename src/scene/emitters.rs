@@ -141,14 +141,14 @@ impl EmitterSampler {
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records })
     }
 
-    /// What [`EmitterSampler::pick`] picks for the same u, as light sampling reads it, for the selections that
-    /// do not depend on the shading point (`None` for [`LightSelection::Contribution`]).
+    /// What [`EmitterSampler::pick`] picks for eight uniforms (record i for `u[i]`), as light sampling reads it,
+    /// for the selections that do not depend on the shading point (`None` for [`LightSelection::Contribution`]).
     #[inline(always)]
-    pub fn pick_fixed(&self, u: f32) -> Option<&EmitterTriangle> {
+    pub fn pick_fixed_lanes(&self, u: [f32; 8]) -> Option<[&EmitterTriangle; 8]> {
         if self.records.is_empty() {
             return None;
         }
-        Some(&self.records[self.distribution.sample_index(u)])
+        Some(self.distribution.sample_indices(u).map(|i| &self.records[i]))
     }
 
     /// Picks an emitter triangle Δ for the shading point p with one uniform; returns it and p_Δ. `None` where
@@ -224,16 +224,19 @@ mod tests {
         let scene = load_scene("veach-mis").unwrap();
         for selection in LightSelection::ALL {
             let sampler = EmitterSampler::new(&scene, selection).unwrap();
-            for i in 0..10_000 {
-                let u = i as f32 / 10_000.0;
-                let Some(e) = sampler.pick_fixed(u) else {
+            for i in (0..10_000).step_by(8) {
+                let u = std::array::from_fn(|l| (i + l) as f32 / 10_000.0);
+                let Some(records) = sampler.pick_fixed_lanes(u) else {
                     assert_eq!(selection, LightSelection::Contribution);
                     continue;
                 };
-                let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
-                let tri = &scene.triangles[t as usize];
-                assert_eq!((e.v, e.n, e.area, e.p_delta, e.material), (tri.v, tri.n, tri.area, p_delta, tri.material));
-                assert_eq!(e.convex_group, scene.convex_group(t).unwrap_or(SKIP_NONE));
+                for (e, u) in records.iter().zip(u) {
+                    let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
+                    let tri = &scene.triangles[t as usize];
+                    let record = (e.v, e.n, e.area, e.p_delta, e.material);
+                    assert_eq!(record, (tri.v, tri.n, tri.area, p_delta, tri.material));
+                    assert_eq!(e.convex_group, scene.convex_group(t).unwrap_or(SKIP_NONE));
+                }
             }
         }
     }
