@@ -12,7 +12,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Duration;
-use wide::f32x8;
+use wide::{CmpLt, f32x8};
 
 /// Passes of at least this many samples per pixel gather, once per pixel, the few triangles its camera rays
 /// can hit (an exact cull: see `scene::accel::frustum`), and take the samples eight at a time, one per SIMD
@@ -172,7 +172,8 @@ impl<'a> Renderer<'a> {
         let dirs = self.camera.directions(x, y, jitter_x, jitter_y);
         let hits = match cone {
             Some(cone) => {
-                let active = f32x8::new(std::array::from_fn(|l| if l < n { f32::from_bits(u32::MAX) } else { 0.0 }));
+                // All bits set in lanes 0..n (a comparison's true).
+                let active = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32));
                 cone.closest_hits(&dirs, active, f32::INFINITY)
             }
             None => HitLanes::from_hits(&std::array::from_fn(|l| {
