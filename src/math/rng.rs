@@ -127,11 +127,8 @@ impl PixelStreams {
     /// The streams of samples `first..first + 8`, lane i holding [`PixelStreams::sample`]`(first + i)`.
     #[inline(always)]
     pub fn samples(&self, first: u64) -> SampleRngLanes {
-        let increment = (self.stream << 1) | 1;
-        let state = std::array::from_fn(|i| {
-            lcg_step(self.sample_state(first.wrapping_add(i as u64)).wrapping_add(increment), increment)
-        });
-        SampleRngLanes { state, increment }
+        let streams: [SampleRng; 8] = std::array::from_fn(|i| self.sample(first.wrapping_add(i as u64)));
+        SampleRngLanes { state: streams.map(|s| s.state), increment: streams[0].increment }
     }
 
     #[inline(always)]
