@@ -128,7 +128,7 @@ fn rays(c: &mut Criterion) {
         let cones: Vec<_> = (0..w * h)
             .filter_map(|i| {
                 let (x, y) = (i % w, i / w);
-                scene.accel().cone_candidates(basis.eye(), basis.pixel_corners(x, y)).map(|c| (x, y, c))
+                scene.cone_candidates(basis.eye(), basis.pixel_corners(x, y)).map(|c| (x, y, c))
             })
             .take(4096)
             .collect();

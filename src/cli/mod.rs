@@ -298,7 +298,7 @@ pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
 }
 
 /// Samples per pixel per pass: about 8 M samples, so a pass takes a few tenths of a second and the cost of
-/// gathering each pixel's camera-ray candidates (once per pass) is spread over many samples.
+/// gathering each pixel's camera-ray candidates into a packet (once per pass) is spread over many samples.
 pub(crate) fn pass_size(spp: u32, pixels: usize) -> u32 {
     ((8_000_000 / pixels.max(1)) as u32).clamp(1, spp)
 }

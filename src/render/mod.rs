@@ -1,5 +1,6 @@
 //! Estimators of the scattering integral and the machinery that runs them over an image.
 
+mod cones;
 mod estimator;
 mod film;
 mod lanes;

@@ -2,6 +2,7 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
+use super::cones::PixelCones;
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
 use super::strategy::MisSettings;
 use super::{Film, LightTechnique, PixelAccum, ShadingPoint, Strategy, estimate_direct};
@@ -15,8 +16,9 @@ use std::time::Duration;
 use wide::{CmpLt, f32x8};
 
 /// Passes of at least this many samples per pixel gather, once per pixel, the few triangles its camera rays
-/// can hit (an exact cull: see `scene::accel::frustum`), and take the samples eight at a time, one per SIMD
-/// lane (see `super::lanes`). Both give the one-sample path's values bit for bit.
+/// can hit (an exact cull: see `scene::accel::frustum`; found on the first such pass and kept, see
+/// `super::cones`), and take the samples eight at a time, one per SIMD lane (see `super::lanes`). Both give
+/// the one-sample path's values bit for bit.
 const GROUP_MIN_SAMPLES: u32 = 4;
 
 /// What a render is a function of, besides the scene.
@@ -69,6 +71,7 @@ pub struct Renderer<'a> {
     emitters: Option<EmitterSampler>,
     camera: CameraBasis,
     size: (u32, u32),
+    cones: PixelCones,
 }
 
 impl<'a> Renderer<'a> {
@@ -84,6 +87,7 @@ impl<'a> Renderer<'a> {
             emitters: EmitterSampler::new(scene, settings.light_selection),
             camera: camera.basis(),
             size: (camera.width, camera.height),
+            cones: PixelCones::new(camera.height),
         }
     }
 
@@ -116,24 +120,28 @@ impl<'a> Renderer<'a> {
                     }
                 };
                 let mut rays = 0;
-                for (x, acc) in row.iter_mut().enumerate() {
-                    let streams = PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
-                    let (x, y) = (x as u32, y as u32);
-                    if count < GROUP_MIN_SAMPLES {
+                let streams = |x: usize| PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
+                if count < GROUP_MIN_SAMPLES {
+                    for (x, acc) in row.iter_mut().enumerate() {
+                        let streams = streams(x);
                         for s in first..first + count {
                             let mut rng = streams.sample(s as u64);
-                            let (dir, hit) = self.camera_ray(x, y, &mut rng);
+                            let (dir, hit) = self.camera_ray(x as u32, y as u32, &mut rng);
                             rays += 1;
                             add(acc, hit.map_or(Vec3::ZERO, |hit| self.shade(dir, &hit, &mut rng, &mut rays)));
                         }
-                        continue;
                     }
-                    let cone = self.scene.accel().cone_candidates(self.camera.eye(), self.camera.pixel_corners(x, y));
-                    for group in (first..first + count).step_by(LANES) {
-                        let samples = group..(group + LANES as u32).min(first + count);
-                        let n = samples.len();
-                        let values = self.sample_lanes((x, y), &streams, samples, cone.as_ref(), &mut rays);
-                        values[..n].iter().for_each(|&v| add(acc, v));
+                } else {
+                    let cones = self.cones.row(self.scene, &self.camera, y as u32, width);
+                    for ((x, acc), cone) in row.iter_mut().enumerate().zip(cones) {
+                        let streams = streams(x);
+                        for group in (first..first + count).step_by(LANES) {
+                            let samples = group..(group + LANES as u32).min(first + count);
+                            let n = samples.len();
+                            let pixel = (x as u32, y as u32);
+                            let values = self.sample_lanes(pixel, &streams, samples, cone.as_ref(), &mut rays);
+                            values[..n].iter().for_each(|&v| add(acc, v));
+                        }
                     }
                 }
                 stats.rays = rays;
@@ -245,7 +253,8 @@ mod tests {
                     film
                 };
                 let one_by_one = film(&[1; 13]);
-                for passes in [&[13][..], &[3, 10]] {
+                // (Passes of 5 and 8 take the second's cones from the first.)
+                for passes in [&[13][..], &[3, 10], &[5, 8]] {
                     assert!(
                         film(passes).pixels == one_by_one.pixels,
                         "{name}, {} ({}): passes {passes:?} differ from one sample at a time",

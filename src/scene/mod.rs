@@ -11,7 +11,7 @@ mod file;
 mod load;
 mod material;
 
-pub use accel::{Accel, ConeCandidates, Hit, HitLanes, SKIP_NONE};
+pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
@@ -145,6 +145,18 @@ impl Scene {
     pub fn hit_point(&self, hit: &Hit) -> Vec3 {
         let [v0, v1, v2] = self.triangles[hit.triangle as usize].v;
         v0 + (v1 - v0) * hit.u + (v2 - v0) * hit.v
+    }
+
+    /// The triangles that camera rays from `apex` through the quad of directions `corners` can hit, in one
+    /// packet; `None` when there are more than eight (see [`Accel::cone_triangles`]).
+    pub fn cone_candidates(&self, apex: Vec3, corners: [Vec3; 4]) -> Option<ConeCandidates> {
+        Some(self.cone(apex, &self.accel.cone_triangles(apex, corners)?))
+    }
+
+    /// The cone from `apex` of the triangles `ids` (at most eight).
+    #[inline]
+    pub fn cone(&self, apex: Vec3, ids: &[u32]) -> ConeCandidates {
+        ConeCandidates::new(apex, ids.len(), |i| (self.triangles[ids[i] as usize].v, ids[i]))
     }
 
     #[inline]

@@ -21,16 +21,20 @@ pub struct ConeCandidates {
     packet: TrianglePacket,
 }
 
+/// The ids of the triangles a cone can hit: 4 bytes a triangle, small enough to keep for every pixel of an
+/// image.
+pub type ConeTriangles = ArrayVec<u32, 8>;
+
 impl Accel {
     /// The triangles that rays from `apex` through the quad of directions `corners` (in order around it) can
     /// hit; `None` when there are more than eight of them (trace such rays with [`Accel::closest_hit`]).
-    pub fn cone_candidates(&self, apex: Vec3, corners: [Vec3; 4]) -> Option<ConeCandidates> {
+    pub fn cone_triangles(&self, apex: Vec3, corners: [Vec3; 4]) -> Option<ConeTriangles> {
         let centre = corners.iter().sum::<Vec3>();
         let normals = [0, 1, 2, 3].map(|i| {
             let n = corners[i].cross(corners[(i + 1) % 4]);
             if n.dot(centre) < 0.0 { -n } else { n }
         });
-        let mut found: ArrayVec<(&TrianglePacket, usize), 8> = ArrayVec::new();
+        let mut found = ConeTriangles::new();
         let mut stack = ArrayVec::<Child, STACK>::new();
         stack.push(self.root?);
         while let Some(child) = stack.pop() {
@@ -39,7 +43,7 @@ impl Accel {
                     for lane in 0..8 {
                         let Some(v) = packet.vertices(lane) else { continue };
                         let outside = normals.iter().any(|n| v.iter().all(|&p| n.dot(p - apex) < 0.0));
-                        if !outside && found.try_push((packet, lane)).is_err() {
+                        if !outside && found.try_push(packet.ids[lane]).is_err() {
                             return None;
                         }
                     }
@@ -53,11 +57,19 @@ impl Accel {
                 }
             }
         }
-        Some(ConeCandidates { apex, packet: TrianglePacket::gather(&found) })
+        Some(found)
     }
 }
 
 impl ConeCandidates {
+    /// The cone from `apex` whose `n` triangles (at most eight: the ones [`Accel::cone_triangles`] found) are
+    /// `triangle(i)` = (vertices, id), i < n. With the vertices the tree was built from, its packet holds the
+    /// same numbers as the tree's (both are built by `TrianglePacket::from_fn`), so its hits are the tree's.
+    #[inline]
+    pub fn new(apex: Vec3, n: usize, triangle: impl Fn(usize) -> ([Vec3; 3], u32)) -> Self {
+        Self { apex, packet: TrianglePacket::from_fn(n, triangle) }
+    }
+
     /// The closest hit along `apex + t·dir`, 0 < t < t_max, for a direction inside the cone: the same hit
     /// [`Accel::closest_hit`] finds.
     #[inline]
@@ -90,7 +102,7 @@ mod tests {
             let mut cones = 0;
             for y in 0..camera.height {
                 for x in 0..camera.width {
-                    let Some(cone) = scene.accel().cone_candidates(basis.eye(), basis.pixel_corners(x, y)) else {
+                    let Some(cone) = scene.cone_candidates(basis.eye(), basis.pixel_corners(x, y)) else {
                         continue;
                     };
                     cones += 1;

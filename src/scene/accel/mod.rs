@@ -11,7 +11,7 @@ mod packet;
 mod ray;
 mod traverse;
 
-pub use frustum::ConeCandidates;
+pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;

@@ -32,36 +32,24 @@ pub(super) struct TrianglePacket {
 impl TrianglePacket {
     /// Up to eight triangles, with their ids.
     pub fn new(triangles: &[([Vec3; 3], u32)]) -> Self {
-        assert!(triangles.len() <= 8, "a packet holds at most eight triangles");
-        let mut soa = [[[0.0f32; 8]; 3]; 3];
-        let mut ids = [u32::MAX; 8];
-        for (lane, ([a, b, c], id)) in triangles.iter().enumerate() {
-            for (k, v) in [*a, *b - *a, *c - *a].into_iter().enumerate() {
-                for axis in 0..3 {
-                    soa[k][axis][lane] = v[axis];
-                }
-            }
-            ids[lane] = *id;
-        }
-        let [v0, e1, e2] = soa.map(|vec| vec.map(f32x8::new));
-        Self { v0, e1, e2, ids }
+        Self::from_fn(triangles.len(), |i| triangles[i])
     }
 
-    /// A packet of lanes taken from other packets (unused lanes left empty).
-    pub fn gather(lanes: &[(&TrianglePacket, usize)]) -> Self {
-        assert!(lanes.len() <= 8, "a packet holds at most eight triangles");
-        let mut soa = [[[0.0f32; 8]; 3]; 3];
+    /// The `n` triangles `triangle(i)` = (vertices, id), i < n ≤ 8. Each triangle's nine coordinates go in as
+    /// two rows, which one transposition turns into a vector per coordinate.
+    #[inline]
+    pub fn from_fn(n: usize, triangle: impl Fn(usize) -> ([Vec3; 3], u32)) -> Self {
+        assert!(n <= 8, "a packet holds at most eight triangles");
+        let (mut rows, mut last) = ([f32x8::ZERO; 8], [0.0; 8]);
         let mut ids = [u32::MAX; 8];
-        for (i, &(packet, lane)) in lanes.iter().enumerate() {
-            for (k, vector) in [&packet.v0, &packet.e1, &packet.e2].into_iter().enumerate() {
-                for axis in 0..3 {
-                    soa[k][axis][i] = vector[axis].as_array_ref()[lane];
-                }
-            }
-            ids[i] = packet.ids[lane];
+        for lane in 0..n {
+            let ([a, b, c], id) = triangle(lane);
+            rows[lane] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
+            (last[lane], ids[lane]) = (c.z, id);
         }
-        let [v0, e1, e2] = soa.map(|vec| vec.map(f32x8::new));
-        Self { v0, e1, e2, ids }
+        let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows);
+        let cz = f32x8::new(last);
+        Self { v0: [ax, ay, az], e1: [bx - ax, by - ay, bz - az], e2: [cx - ax, cy - ay, cz - az], ids }
     }
 
     /// The vertices of the triangle in `lane`, or `None` for an unused lane.
