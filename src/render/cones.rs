@@ -1,13 +1,14 @@
 //! Per pixel, the few triangles its camera rays can hit (`Accel::cone_triangles`), found on the first pass that
-//! needs them and kept for the later ones: the cull depends only on the scene and the camera, not on the
-//! samples, so a pass of 32 samples per pixel does not walk the tree once per pixel to find them again. Kept as
-//! triangle ids (4 bytes a triangle), a row at a time, each row filled by the thread that renders it first.
+//! needs them and kept for the later ones: the cull depends only on the scene's geometry and the camera, not on
+//! the samples, so a pass of 32 samples per pixel does not walk the tree once per pixel to find them again. Kept
+//! as triangle ids (4 bytes a triangle), a row at a time, each row filled by the thread that renders it first.
 
-use crate::scene::{CameraBasis, ConeCandidates, Scene};
+use crate::scene::{Camera, CameraBasis, ConeCandidates, Scene};
 use std::sync::OnceLock;
 
-/// The cones of every pixel of an image, row by row.
-pub(super) struct PixelCones {
+/// The cones of every pixel of one camera's image, row by row, for one scene geometry (materials may change).
+pub struct PixelCones {
+    camera: Camera,
     rows: Vec<OnceLock<RowCones>>,
 }
 
@@ -22,13 +23,19 @@ struct RowCones {
 const NO_CONE: u32 = u32::MAX;
 
 impl PixelCones {
-    pub fn new(height: u32) -> Self {
-        Self { rows: (0..height).map(|_| OnceLock::new()).collect() }
+    /// None found yet.
+    pub fn new(camera: &Camera) -> Self {
+        Self { camera: *camera, rows: (0..camera.height).map(|_| OnceLock::new()).collect() }
+    }
+
+    /// The camera whose pixels these are.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
     }
 
     /// The cone of every pixel of row `y` (of `width` pixels), one at a time: `None` for a pixel whose rays can
     /// hit more than eight triangles. Found on the first call for the row.
-    pub fn row<'a>(
+    pub(super) fn row<'a>(
         &'a self,
         scene: &'a Scene,
         camera: &'a CameraBasis,

@@ -9,6 +9,7 @@ mod pass;
 mod shading;
 pub mod strategy;
 
+pub use cones::PixelCones;
 pub use estimator::{SEGMENT_END, estimate_direct};
 pub use film::{Film, PixelAccum};
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};

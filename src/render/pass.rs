@@ -2,16 +2,16 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
-use super::cones::PixelCones;
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
 use super::strategy::MisSettings;
-use super::{Film, LightTechnique, PixelAccum, ShadingPoint, Strategy, estimate_direct};
+use super::{Film, LightTechnique, PixelAccum, PixelCones, ShadingPoint, Strategy, estimate_direct};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
+use std::sync::Arc;
 use std::time::Duration;
 use wide::{CmpLt, f32x8};
 
@@ -71,7 +71,7 @@ pub struct Renderer<'a> {
     emitters: Option<EmitterSampler>,
     camera: CameraBasis,
     size: (u32, u32),
-    cones: PixelCones,
+    cones: Arc<PixelCones>,
 }
 
 impl<'a> Renderer<'a> {
@@ -87,8 +87,24 @@ impl<'a> Renderer<'a> {
             emitters: EmitterSampler::new(scene, settings.light_selection),
             camera: camera.basis(),
             size: (camera.width, camera.height),
-            cones: PixelCones::new(camera.height),
+            cones: Arc::new(PixelCones::new(camera)),
         }
+    }
+
+    /// The pixel cones this renderer found and keeps, to give to a later renderer of the same scene geometry
+    /// ([`Renderer::with_cones`]).
+    pub fn cones(&self) -> Arc<PixelCones> {
+        self.cones.clone()
+    }
+
+    /// Takes the pixel cones an earlier renderer found (e.g. a viewer's, which makes a renderer per pass), if they
+    /// are for this renderer's camera, so that they are not found again. They must be for this scene's geometry:
+    /// cones of other triangles would cull the wrong ones.
+    pub fn with_cones(mut self, cones: Arc<PixelCones>) -> Self {
+        if cones.camera() == self.cones.camera() {
+            self.cones = cones;
+        }
+        self
     }
 
     /// Adds samples `first..first + count` to every pixel of `film` (which must match the camera's size).
@@ -222,6 +238,25 @@ impl<'a> Renderer<'a> {
 mod tests {
     use super::*;
     use crate::scene::every_bundled_scene;
+
+    /// A renderer takes an earlier one's pixel cones for its own camera only, and renders with them what it
+    /// renders with the cones it finds itself.
+    #[test]
+    fn kept_cones_are_taken_for_the_same_camera_only() {
+        let (_, scene, camera) = every_bundled_scene(24, 16).find(|(name, ..)| *name == "veach-mis").expect("bundled");
+        let first = Renderer::with_camera(&scene, RenderSettings::default(), &camera);
+        let mut kept = Film::new(camera.width, camera.height);
+        first.render_pass(&mut kept, 0, 8, &|| false);
+        let second = Renderer::with_camera(&scene, RenderSettings::default(), &camera).with_cones(first.cones());
+        assert!(Arc::ptr_eq(&second.cones(), &first.cones()), "same camera: the cones are taken");
+        second.render_pass(&mut kept, 8, 8, &|| false);
+        let mut fresh = Film::new(camera.width, camera.height);
+        Renderer::with_camera(&scene, RenderSettings::default(), &camera).render_pass(&mut fresh, 0, 16, &|| false);
+        assert!(kept.pixels == fresh.pixels, "kept cones change the film");
+        let moved = Camera { eye: camera.eye + Vec3::new(0.1, 0.0, 0.0), ..camera };
+        let third = Renderer::with_camera(&scene, RenderSettings::default(), &moved).with_cones(first.cones());
+        assert!(!Arc::ptr_eq(&third.cones(), &first.cones()), "another camera: its own cones");
+    }
 
     /// Thirteen samples per pixel in one pass (through each pixel's cone, eight lanes then five), in thirteen
     /// passes of one (a full traversal and the one-sample estimator each) and in passes of three and ten give the

@@ -18,7 +18,7 @@ mod reference_job;
 
 pub use frame::{Frame, ReferenceStatus};
 
-use crate::render::{Film, RenderSettings, Renderer};
+use crate::render::{Film, PixelCones, RenderSettings, Renderer};
 use crate::scene::{Camera, Material, Scene};
 use lane::Lane;
 use reference_job::ReferenceJob;
@@ -191,6 +191,9 @@ impl Drop for Worker {
 /// Everything the worker thread owns.
 struct State {
     scene: Arc<Scene>,
+    /// The pixel cones the lanes' passes found for this scene's geometry (and its camera, which each renderer
+    /// checks), kept from pass to pass.
+    cones: Option<Arc<PixelCones>>,
     lanes: [Lane; 2],
     comparing: bool,
     budget: Budget,
@@ -226,6 +229,7 @@ impl State {
         let lanes = [Lane::new(settings, &scene.camera), Lane::new(settings, &scene.camera)];
         Self {
             scene,
+            cones: None,
             lanes,
             comparing: false,
             budget: Budget::EqualSamples,
@@ -326,7 +330,10 @@ impl State {
     /// Returns false on `Quit`.
     fn apply(&mut self, command: Command) -> bool {
         match command {
-            Command::SetScene(scene) => self.scene = scene,
+            Command::SetScene(scene) => {
+                self.scene = scene;
+                self.cones = None;
+            }
             Command::SetSettings(s) => self.lanes[A].settings = s,
             Command::SetCompare(b) => {
                 self.comparing = b.is_some();
@@ -335,7 +342,10 @@ impl State {
                 }
             }
             Command::SetBudget(b) => self.budget = b,
-            Command::SetCamera(camera) => Arc::make_mut(&mut self.scene).camera = camera,
+            Command::SetCamera(camera) => {
+                Arc::make_mut(&mut self.scene).camera = camera;
+                self.cones = None;
+            }
             Command::SetMaterial { index, material } => {
                 if let Some(m) = Arc::make_mut(&mut self.scene).materials.get_mut(index) {
                     *m = material;
@@ -438,8 +448,12 @@ impl State {
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
         let start = Instant::now();
-        let renderer = Renderer::new(&self.scene, lane.settings);
+        let mut renderer = Renderer::new(&self.scene, lane.settings);
+        if let Some(cones) = &self.cones {
+            renderer = renderer.with_cones(cones.clone());
+        }
         let stats = pool.install(|| renderer.render_pass(&mut lane.film, lane.spp, count, &cancelled));
+        self.cones = Some(renderer.cones());
         if cancelled() {
             return; // partial: the pending command restarts this film
         }

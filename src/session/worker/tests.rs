@@ -75,6 +75,29 @@ fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
     assert_eq!(f.radiance, film.means());
 }
 
+/// Passes of 4 spp go through the pixel cones, which the worker keeps from pass to pass and finds again when the
+/// camera moves: the film is a one-shot render's, bit for bit, before and after the move.
+#[test]
+fn kept_pixel_cones_give_the_one_shot_image_and_follow_the_camera() {
+    let scene = small_scene();
+    let one_shot = |scene: &Scene| {
+        let mut film = Film::new(32, 32);
+        Renderer::new(scene, RenderSettings::default()).render_pass(&mut film, 0, 12, &|| false);
+        film.means()
+    };
+    let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
+    worker.send(Command::SetSppPerPass(4));
+    worker.send(Command::SetTargetSpp(Some(12)));
+    let f = wait_for(&worker, |f| f.spp == 12);
+    assert_eq!(f.passes, 3);
+    assert_eq!(f.radiance, one_shot(&scene));
+    let mut moved = (*scene).clone();
+    moved.camera.eye += glam::Vec3::new(0.3, 0.1, 0.0);
+    worker.send(Command::SetCamera(moved.camera));
+    let g = wait_for(&worker, |g| g.spp == 12 && g.camera == moved.camera);
+    assert_eq!(g.radiance, one_shot(&moved));
+}
+
 #[test]
 fn equal_samples_with_common_random_numbers_makes_identical_strategies_identical() {
     let worker = Worker::spawn(small_scene(), settings(Strategy::Brdf), 1, || {});
