@@ -31,6 +31,21 @@ impl Vec3x8 {
         Self { x: f32x8::new(v.map(|v| v.x)), y: f32x8::new(v.map(|v| v.y)), z: f32x8::new(v.map(|v| v.z)) }
     }
 
+    /// A triangle's first eight vertex coordinates (v₀, v₁, v₂.x, v₂.y) as one row: eight triangles' rows and
+    /// their v₂.z become one vector per vertex through [`Vec3x8::triangles`].
+    #[inline(always)]
+    pub fn triangle_row([a, b, c]: [Vec3; 3]) -> f32x8 {
+        f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y])
+    }
+
+    /// The vertices of eight triangles, lane i from triangle i's row `rows[i]` ([`Vec3x8::triangle_row`]) and
+    /// its v₂.z in lane i of `last`: one 8×8 transpose.
+    #[inline(always)]
+    pub fn triangles(rows: [f32x8; 8], last: f32x8) -> [Self; 3] {
+        let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows);
+        [Self::new(ax, ay, az), Self::new(bx, by, bz), Self::new(cx, cy, last)]
+    }
+
     #[inline(always)]
     pub fn lane(&self, i: usize) -> Vec3 {
         Vec3::new(self.x.as_array_ref()[i], self.y.as_array_ref()[i], self.z.as_array_ref()[i])

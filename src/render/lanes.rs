@@ -38,15 +38,14 @@ pub fn estimate_emitter_lanes(
     let mut materials = [0; LANES];
     for_each_lane(hit_lanes, |l| {
         let tri = &scene.triangles[hits.triangle[l] as usize];
-        let ([a, b, c], n) = (tri.v, tri.n);
-        rows[0][l] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
+        let (c, n) = (tri.v[2], tri.n);
+        rows[0][l] = Vec3x8::triangle_row(tri.v);
         rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, 0.0, 0.0, 0.0, 0.0]);
         materials[l] = tri.material;
     });
-    let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows[0]);
     let [cz, nx, ny, nz, _, _, _, _] = f32x8::transpose(rows[1]);
+    let [a, b, c] = Vec3x8::triangles(rows[0], cz);
     let (u, v) = (hits.u, hits.v);
-    let (a, b, c) = (Vec3x8::new(ax, ay, az), Vec3x8::new(bx, by, bz), Vec3x8::new(cx, cy, cz));
     let p = a + (b - a) * u + (c - a) * v;
     let wo = -*dirs;
     let geometric = Vec3x8::new(nx, ny, nz);
@@ -75,9 +74,8 @@ pub fn estimate_emitter_lanes(
             }
         });
     }
-    let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(lo);
     let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
-    let (la, lb, lc) = (Vec3x8::new(ax, ay, az), Vec3x8::new(bx, by, bz), Vec3x8::new(cx, cy, cz));
+    let [la, lb, lc] = Vec3x8::triangles(lo, cz);
     let ln = Vec3x8::new(nx, ny, nz);
     // The picked triangle's material (u32::MAX for none) and convex emitter group.
     let light_material = material.to_array().map(f32::to_bits);

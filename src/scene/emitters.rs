@@ -1,7 +1,7 @@
 //! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
 use super::{SKIP_NONE, Scene};
-use crate::math::luminance;
+use crate::math::{Vec3x8, luminance};
 use crate::sampling::DiscreteDistribution;
 use glam::Vec3;
 use wide::f32x8;
@@ -96,10 +96,7 @@ impl EmitterTriangle {
     pub fn rows(&self) -> [f32x8; 2] {
         let ([a, b, c], n) = (self.v, self.n);
         let (material, group) = (f32::from_bits(self.material), f32::from_bits(self.convex_group));
-        [
-            f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]),
-            f32x8::new([c.z, n.x, n.y, n.z, self.area, self.p_delta, material, group]),
-        ]
+        [Vec3x8::triangle_row([a, b, c]), f32x8::new([c.z, n.x, n.y, n.z, self.area, self.p_delta, material, group])]
     }
 }
 

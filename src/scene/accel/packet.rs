@@ -35,8 +35,8 @@ impl TrianglePacket {
         Self::from_fn(triangles.len(), |i| triangles[i])
     }
 
-    /// The `n` triangles `triangle(i)` = (vertices, id), i < n ≤ 8. Each triangle's nine coordinates go in as
-    /// two rows, which one transposition turns into a vector per coordinate.
+    /// The `n` triangles `triangle(i)` = (vertices, id), i < n ≤ 8. Each triangle's first eight coordinates go in
+    /// as a row, which one transposition turns into a vector per coordinate.
     #[inline]
     pub fn from_fn(n: usize, triangle: impl Fn(usize) -> ([Vec3; 3], u32)) -> Self {
         assert!(n <= 8, "a packet holds at most eight triangles");
@@ -44,12 +44,12 @@ impl TrianglePacket {
         let mut ids = [u32::MAX; 8];
         for lane in 0..n {
             let ([a, b, c], id) = triangle(lane);
-            rows[lane] = f32x8::new([a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y]);
+            rows[lane] = Vec3x8::triangle_row([a, b, c]);
             (last[lane], ids[lane]) = (c.z, id);
         }
-        let [ax, ay, az, bx, by, bz, cx, cy] = f32x8::transpose(rows);
-        let cz = f32x8::new(last);
-        Self { v0: [ax, ay, az], e1: [bx - ax, by - ay, bz - az], e2: [cx - ax, cy - ay, cz - az], ids }
+        let [a, b, c] = Vec3x8::triangles(rows, f32x8::new(last));
+        let [e1, e2] = [b - a, c - a].map(|e| [e.x, e.y, e.z]);
+        Self { v0: [a.x, a.y, a.z], e1, e2, ids }
     }
 
     /// The vertices of the triangle in `lane`, or `None` for an unused lane.
