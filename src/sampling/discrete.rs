@@ -69,8 +69,8 @@ impl DiscreteDistribution {
         let x = u.map(|u| u as f64 * n as f64);
         let bucket = x.map(|x| (x as i32).min(n as i32 - 1));
         std::array::from_fn(|l| {
-            let (q, alias) = self.buckets[bucket[l] as usize];
             let b = bucket[l] as usize;
+            let (q, alias) = self.buckets[b];
             std::hint::select_unpredictable(x[l] - (bucket[l] as f64) < q, b, alias as usize)
         })
     }
