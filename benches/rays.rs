@@ -153,7 +153,10 @@ fn rays(c: &mut Criterion) {
         // The integrator, on one thread like the rays above: every ray it traces (camera and shadow rays), with its
         // sampling and shading around them, in passes of 32 samples per pixel over the scene's own image.
         const SPP: u32 = 32;
-        let renderer = Renderer::new(&scene, RenderSettings { strategy: Strategy::Emitter, ..Default::default() });
+        let renderer = Renderer::new(
+            std::sync::Arc::new(scene.clone()),
+            RenderSettings { strategy: Strategy::Emitter, ..Default::default() },
+        );
         let mut film = Film::new(w, h);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
         let rays_per_pass = pool.install(|| renderer.render_pass(&mut film, 0, SPP, &|| false)).rays;
@@ -192,7 +195,10 @@ fn ratio_rounds() {
             black_box(n);
             (work.primary.len() + work.shadow.len()) as f64 / cpu.elapsed().as_secs_f64()
         };
-        let renderer = Renderer::new(&scene, RenderSettings { strategy: Strategy::Emitter, ..Default::default() });
+        let renderer = Renderer::new(
+            std::sync::Arc::new(scene.clone()),
+            RenderSettings { strategy: Strategy::Emitter, ..Default::default() },
+        );
         let mut film = Film::new(scene.camera.width, scene.camera.height);
         let mut first = 0;
         let mut integrator_rate = || {

@@ -5,7 +5,7 @@
 //! asserts nothing. `cargo bench --bench variance`. Rare-event estimators (a light hit once in 10⁵ samples)
 //! show a sample variance below their true one: read very small numbers in those cells with that in mind.
 
-use illumlab::render::{Film, Heuristic, LightTechnique, MisSettings, RenderSettings, Renderer, Strategy};
+use illumlab::render::{Film, Heuristic, MisSettings, RenderSettings, Renderer, Strategy};
 use illumlab::scene::{LightSelection, load_scene};
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -16,8 +16,8 @@ fn settings() -> Vec<(String, RenderSettings)> {
         .filter(|s| *s != Strategy::Mis)
         .map(|strategy| (strategy.name().to_string(), RenderSettings { strategy, ..Default::default() }))
         .collect();
-    for light in LightTechnique::ALL {
-        let mis = MisSettings { light, heuristic: Heuristic::Power, light_samples: 1, brdf_samples: 1 };
+    for light in Strategy::ALL.into_iter().filter(|s| s.samples_lights()) {
+        let mis = MisSettings { techniques: [light, Strategy::Brdf], heuristic: Heuristic::Power, samples: [1, 1] };
         out.push((
             format!("mis ({} + brdf)", light.name()),
             RenderSettings { strategy: Strategy::Mis, mis, ..Default::default() },
@@ -47,7 +47,7 @@ fn table(scene_name: &str, size: (u32, u32), spp: u32, materials: &[&str], colum
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     for (name, mut s) in settings() {
         s.light_selection = LightSelection::Power;
-        let renderer = Renderer::new(&scene, s);
+        let renderer = Renderer::new(std::sync::Arc::new(scene.clone()), s);
         let mut film = Film::new(w, h);
         let start = Instant::now();
         let stats = pool.install(|| renderer.render_pass(&mut film, 0, spp, &|| false));

@@ -20,6 +20,7 @@
 pub mod app;
 pub mod math;
 pub mod measure;
+pub mod probe;
 pub mod render;
 pub mod sampling;
 pub mod scene;

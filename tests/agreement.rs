@@ -24,7 +24,7 @@ struct Region {
 
 fn regions(scene: &Scene, strategy: Strategy, spp: u32, seed: u64) -> Vec<Region> {
     let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed, ..Default::default() };
-    let renderer = Renderer::new(scene, settings);
+    let renderer = Renderer::new(std::sync::Arc::new(scene.clone()), settings);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut film = Film::new(w, h);
     let stats = renderer.render_pass(&mut film, 0, spp, &|| false);
@@ -113,7 +113,7 @@ fn strategies_agree_on_veach_mis_where_both_are_well_sampled() {
         // Light strategies and MIS sample the diffuse backdrop well, so a good part of the image is compared. The
         // hemisphere strategies and BRDF sampling are rare-event estimators almost everywhere at this budget
         // (they are checked against the closed form in `unbiased.rs`): no floor for them.
-        if strategy.light_technique().is_some() || strategy == Strategy::Mis {
+        if strategy.samples_lights() || strategy == Strategy::Mis {
             let channels = 3 * r.len();
             assert!(3 * compared >= channels, "{}: only {compared} of {channels} compared", strategy.name());
         }

@@ -13,7 +13,7 @@ fn scene(w: u32, h: u32) -> Scene {
 
 fn reference(scene: &Scene, spp: u32) -> Reference {
     let mut film = Film::new(scene.camera.width, scene.camera.height);
-    Renderer::new(scene, reference_settings()).render_pass(&mut film, 0, spp, &|| false);
+    Renderer::new(std::sync::Arc::new(scene.clone()), reference_settings()).render_pass(&mut film, 0, spp, &|| false);
     Reference::from_film(&film, 0.0)
 }
 
@@ -38,7 +38,7 @@ fn pooled_mse(
     let k = (seeds.end - seeds.start) as f64;
     for seed in seeds {
         let base = RenderSettings { seed, ..RenderSettings::default() };
-        let report = run_bench(s, r, base, strategies, budgets, |_, _| {});
+        let report = run_bench(&std::sync::Arc::new(s.clone()), r, base, strategies, budgets, |_, _| {});
         for (i, series) in report.series.iter().enumerate() {
             for (j, p) in series.points.iter().enumerate() {
                 sums[i][j] += (p.mse - r.noise_mse()) / k;

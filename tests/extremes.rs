@@ -6,9 +6,7 @@ mod common;
 
 use common::{any_camera, estimate_with, quad};
 use glam::Vec3;
-use illumlab::render::{
-    Film, Heuristic, LightTechnique, MisSettings, RenderSettings, Renderer, ShadingPoint, Strategy,
-};
+use illumlab::render::{Film, Heuristic, MisSettings, RenderSettings, Renderer, ShadingPoint, Strategy};
 use illumlab::scene::{Camera, LightSelection, Material, Scene};
 
 const ALPHAS: [f32; 5] = [0.0, 1e-3, 1.0, 1e3, 1e6];
@@ -66,9 +64,9 @@ fn all_settings() -> Vec<RenderSettings> {
         for strategy in Strategy::ALL.into_iter().filter(|s| *s != Strategy::Mis) {
             out.push(RenderSettings { strategy, light_selection: selection, seed: 5, ..Default::default() });
         }
-        for light in LightTechnique::ALL {
+        for light in Strategy::ALL.into_iter().filter(|s| s.samples_lights()) {
             for heuristic in Heuristic::ALL {
-                let mis = MisSettings { light, heuristic, light_samples: 2, brdf_samples: 1 };
+                let mis = MisSettings { techniques: [light, Strategy::Brdf], heuristic, samples: [2, 1] };
                 out.push(RenderSettings { strategy: Strategy::Mis, light_selection: selection, seed: 5, mis });
             }
         }
@@ -133,9 +131,9 @@ fn renders_of_extreme_scenes_drop_nothing() {
         },
     ];
     for camera in cameras {
-        let scene = scene(camera);
+        let scene = std::sync::Arc::new(scene(camera));
         for settings in all_settings() {
-            let renderer = Renderer::new(&scene, settings);
+            let renderer = Renderer::new(scene.clone(), settings);
             let mut film = Film::new(camera.width, camera.height);
             let stats = renderer.render_pass(&mut film, 0, 2, &|| false);
             assert_eq!(stats.non_finite, 0, "{settings:?}: non-finite samples");
@@ -148,7 +146,7 @@ fn renders_of_extreme_scenes_drop_nothing() {
 fn scene_without_triangles_renders_black() {
     let scene = Scene::new("empty", any_camera(), &[], &[], vec![], vec![]).expect("an empty scene is valid");
     assert!(scene.warnings.iter().any(|w| w.contains("no emitter")));
-    let renderer = Renderer::new(&scene, RenderSettings::default());
+    let renderer = Renderer::new(std::sync::Arc::new(scene), RenderSettings::default());
     let mut film = Film::new(8, 8);
     renderer.render_pass(&mut film, 0, 2, &|| false);
     assert!(film.means().iter().all(|c| *c == Vec3::ZERO));

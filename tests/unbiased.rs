@@ -10,7 +10,7 @@ mod common;
 use common::{any_camera, estimate_with};
 use glam::{DVec3, Vec3};
 use illumlab::math::lambert_polygon_irradiance;
-use illumlab::render::{Heuristic, LightTechnique, MisSettings, RenderSettings, ShadingPoint, Strategy};
+use illumlab::render::{Heuristic, MisSettings, RenderSettings, ShadingPoint, Strategy};
 use illumlab::scene::{LightSelection, Material, Scene};
 use std::f64::consts::PI;
 
@@ -72,7 +72,7 @@ fn closed_form(s: &Setup, p: DVec3) -> DVec3 {
 }
 
 fn check(strategy: Strategy, selection: LightSelection, samples: u64) {
-    let far = if strategy.light_technique().is_some() { samples } else { samples * 64 };
+    let far = if strategy.samples_lights() { samples } else { samples * 64 };
     check_with(RenderSettings { strategy, light_selection: selection, ..Default::default() }, samples, far);
 }
 
@@ -159,16 +159,16 @@ fn projected_solid_angle_is_unbiased_for_every_light_selection() {
 
 #[test]
 fn mis_is_unbiased_for_every_light_technique_and_heuristic() {
-    for light in LightTechnique::ALL {
+    for light in Strategy::ALL.into_iter().filter(|s| s.samples_lights()) {
         for heuristic in Heuristic::ALL {
-            for (light_samples, brdf_samples) in [(1, 1), (3, 1)] {
-                let mis = MisSettings { light, heuristic, light_samples, brdf_samples };
+            for samples in [[1, 1], [3, 1]] {
+                let mis = MisSettings { techniques: [light, Strategy::Brdf], heuristic, samples };
                 let settings = RenderSettings { strategy: Strategy::Mis, mis, ..Default::default() };
                 check_with(settings, 50_000, 50_000);
             }
         }
     }
-    let mis = MisSettings { light: LightTechnique::SolidAngle, ..Default::default() };
+    let mis = MisSettings { techniques: [Strategy::SolidAngle, Strategy::Brdf], ..Default::default() };
     check_with(
         RenderSettings {
             strategy: Strategy::Mis,

@@ -66,7 +66,7 @@ fn choosing_a_strategy_by_its_label_changes_the_render_and_restarts() {
     // (however many passes the worker managed between two UI steps).
     let scene = h.state().scene();
     let mut film = Film::new(f.width, f.height);
-    Renderer::new(scene, f.settings).render_pass(&mut film, 0, f.spp, &|| false);
+    Renderer::new(std::sync::Arc::new(scene.clone()), f.settings).render_pass(&mut film, 0, f.spp, &|| false);
     assert_eq!(f.radiance, film.means(), "the cosine frame at {} spp is a fresh cosine render", f.spp);
 }
 
@@ -180,11 +180,9 @@ fn mis_controls_reach_the_integrator() {
         v.frame()
             .is_some_and(|f| f.settings.strategy == Strategy::Mis && f.settings.mis.heuristic == Heuristic::Balance)
     });
-    h.get_by_role_and_label(Role::Slider, "light / BRDF split").set_value_accesskit(3.0);
+    h.get_by_role_and_label(Role::Slider, "technique 1 / 2 split").set_value_accesskit(3.0);
     h.step();
-    step_until(&mut h, "a 3 + 1 split", |v| {
-        v.frame().is_some_and(|f| f.settings.mis.light_samples == 3 && f.settings.mis.brdf_samples == 1)
-    });
+    step_until(&mut h, "a 3 + 1 split", |v| v.frame().is_some_and(|f| f.settings.mis.samples == [3, 1]));
 }
 
 /// Compare mode end to end: enter it, swap A and B, move the wipe (slider and drag), switch budgets, look at the

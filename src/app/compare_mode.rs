@@ -198,10 +198,9 @@ impl Viewer {
 pub(super) fn series_label(s: &RenderSettings) -> String {
     let mut label = s.strategy.name().to_string();
     if s.strategy == Strategy::Mis {
-        let m = s.mis;
-        label += &format!(" ({}, {}, {}+{})", m.light.name(), m.heuristic.name(), m.light_samples, m.brdf_samples);
+        label += &format!(" ({})", s.mis.label());
     }
-    if s.strategy.light_technique().is_some() || s.strategy == Strategy::Mis {
+    if s.strategy.samples_lights() || s.strategy == Strategy::Mis {
         label += &format!(" [{}]", s.light_selection.name());
     }
     label

@@ -2,7 +2,7 @@
 //! export.
 
 use super::viewer::Viewer;
-use crate::render::{Heuristic, LightTechnique, Strategy};
+use crate::render::{Heuristic, Strategy};
 use crate::scene::{BUNDLED_SCENES, LightSelection};
 use glam::Vec3;
 
@@ -79,14 +79,16 @@ fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     }
 }
 
-/// MIS: which light strategy, which heuristic, and how a pixel sample's directions split between the two.
+/// MIS: which two techniques, which heuristic, and how a pixel sample's directions split between the two.
 fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     let mut mis = v.settings.mis;
-    egui::ComboBox::from_label("MIS light strategy").selected_text(mis.light.name()).show_ui(ui, |ui| {
-        for t in LightTechnique::ALL {
-            ui.selectable_value(&mut mis.light, t, t.name());
-        }
-    });
+    for (i, label) in ["MIS technique 1", "MIS technique 2"].into_iter().enumerate() {
+        egui::ComboBox::from_label(label).selected_text(mis.techniques[i].name()).show_ui(ui, |ui| {
+            for t in Strategy::techniques() {
+                ui.selectable_value(&mut mis.techniques[i], t, t.name());
+            }
+        });
+    }
     ui.horizontal(|ui| {
         for h in Heuristic::ALL {
             ui.radio_value(&mut mis.heuristic, h, h.name());
@@ -94,12 +96,12 @@ fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         ui.label("heuristic");
     });
     // Only a move of the slider re-splits: a split set elsewhere (the command line's 1,1) stays as it is.
-    let mut light = mis.light_samples.min(MIS_DIRECTIONS);
-    if ui.add(egui::Slider::new(&mut light, 0..=MIS_DIRECTIONS).text("light / BRDF split")).changed() {
-        mis.light_samples = light;
-        mis.brdf_samples = MIS_DIRECTIONS - light;
+    let mut first = mis.samples[0].min(MIS_DIRECTIONS);
+    if ui.add(egui::Slider::new(&mut first, 0..=MIS_DIRECTIONS).text("technique 1 / 2 split")).changed() {
+        mis.samples = [first, MIS_DIRECTIONS - first];
     }
-    ui.small(format!("{} light + {} BRDF directions per pixel sample", mis.light_samples, mis.brdf_samples));
+    let [a, b] = mis.techniques.map(|t| t.name());
+    ui.small(format!("{} {a} + {} {b} directions per pixel sample", mis.samples[0], mis.samples[1]));
     if mis != v.settings.mis {
         v.settings.mis = mis;
         v.apply_settings();

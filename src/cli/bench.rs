@@ -49,7 +49,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
     budgets.sort_unstable();
     budgets.dedup();
     let strategies = if args.strategies.is_empty() { Strategy::ALL.to_vec() } else { args.strategies.clone() };
-    let scene = load_sized(&args.scene, args.size)?;
+    let scene = std::sync::Arc::new(load_sized(&args.scene, args.size)?);
     let out = args.out.clone().unwrap_or_else(|| PathBuf::from(format!("bench-{}", scene.name)));
     std::fs::create_dir_all(&out).with_context(|| format!("output folder {}", out.display()))?;
     check_output_path(&out.join("convergence.png"))?;
@@ -125,8 +125,8 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 const WALL: &str = "wall-clock seconds";
 
 /// Renders the reference with [`reference_settings`] in passes of a few samples.
-fn render_reference(scene: &Scene, spp: u32) -> Reference {
-    let renderer = Renderer::new(scene, reference_settings());
+fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32) -> Reference {
+    let renderer = Renderer::new(scene.clone(), reference_settings());
     let mut film = Film::new(scene.camera.width, scene.camera.height);
     let chunk = pass_size(spp, film.pixels.len());
     let bar = indicatif::ProgressBar::new(spp as u64).with_style(

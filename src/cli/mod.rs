@@ -1,12 +1,12 @@
-//! The headless command line: `render`, `bench` and `strategies`.
+//! The headless command line: `render`, `bench`, `probe` and `strategies`.
 
 mod bench;
+mod probe;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use illumlab::render::{
-    Film, Heuristic, LightTechnique, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
-    write_image,
+    Film, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path, write_image,
 };
 use illumlab::scene::{LightSelection, Scene, load_scene};
 use illumlab::session::views::View;
@@ -30,6 +30,9 @@ pub enum Command {
     /// Measure the speed/accuracy trade: every strategy at several budgets against a reference; writes CSV,
     /// markdown and a log–log plot of RMSE against spp and seconds.
     Bench(bench::BenchArgs),
+    /// Probe one pixel's shading point: the estimate against a quadrature, the chi-square of the sampler there,
+    /// and the hemisphere picture.
+    Probe(probe::ProbeArgs),
     /// List the sampling strategies: name, then a one-line description.
     Strategies,
 }
@@ -108,13 +111,16 @@ pub struct ViewArgs {
 /// The options of `--strategy mis`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct MisArgs {
-    /// MIS: the light strategy combined with BRDF sampling (emitter, solid-angle, projected-solid-angle).
-    #[arg(long, value_parser = parse_light_technique, default_value = "emitter")]
-    pub mis_light: LightTechnique,
+    /// MIS: its first technique, by default a light strategy (any strategy but mis).
+    #[arg(long, value_parser = parse_technique, default_value = "emitter")]
+    pub mis_light: Strategy,
+    /// MIS: its second technique, by default BRDF sampling (any strategy but mis).
+    #[arg(long, value_parser = parse_technique, default_value = "brdf")]
+    pub mis_brdf: Strategy,
     /// MIS: balance or power heuristic.
     #[arg(long, value_parser = parse_heuristic, default_value = "power")]
     pub mis_heuristic: Heuristic,
-    /// MIS: light and BRDF samples per pixel sample, as L,B.
+    /// MIS: directions per pixel sample from the first and the second technique, as L,B.
     #[arg(long, value_parser = parse_mis_samples, default_value = "1,1")]
     pub mis_samples: (u32, u32),
 }
@@ -122,17 +128,18 @@ pub struct MisArgs {
 impl MisArgs {
     pub(crate) fn settings(&self) -> MisSettings {
         MisSettings {
-            light: self.mis_light,
+            techniques: [self.mis_light, self.mis_brdf],
             heuristic: self.mis_heuristic,
-            light_samples: self.mis_samples.0,
-            brdf_samples: self.mis_samples.1,
+            samples: [self.mis_samples.0, self.mis_samples.1],
         }
     }
 }
 
-fn parse_light_technique(s: &str) -> Result<LightTechnique, String> {
-    LightTechnique::from_name(s)
-        .ok_or_else(|| "unknown light strategy (one of: emitter, solid-angle, projected-solid-angle)".into())
+fn parse_technique(s: &str) -> Result<Strategy, String> {
+    Strategy::techniques().find(|t| t.name() == s).ok_or_else(|| {
+        let names: Vec<&str> = Strategy::techniques().map(|s| s.name()).collect();
+        format!("unknown MIS technique (one of: {})", names.join(", "))
+    })
 }
 
 fn parse_heuristic(s: &str) -> Result<Heuristic, String> {
@@ -201,6 +208,7 @@ pub fn run(command: Command) -> Result<()> {
         }
         Command::Render(args) => render(args),
         Command::Bench(args) => bench::bench(args),
+        Command::Probe(args) => probe::probe(args),
         Command::View(args) if !args.exposure.is_finite() => bail!("--exposure must be a finite number of stops"),
         Command::View(args) => illumlab::app::run(illumlab::app::ViewOptions {
             scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),
@@ -235,8 +243,8 @@ fn render(args: RenderArgs) -> Result<()> {
         seed: args.seed,
         mis: args.mis.settings(),
     };
-    let renderer = Renderer::new(&scene, settings);
     let mut film = Film::new(scene.camera.width, scene.camera.height);
+    let renderer = Renderer::new(std::sync::Arc::new(scene), settings);
 
     // Passes of a few samples each: the progress bar advances between them; the result does not depend on it.
     let chunk = pass_size(args.spp, film.pixels.len());

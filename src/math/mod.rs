@@ -1,12 +1,14 @@
 //! Pure math: orthonormal frames, robust ray origins, seeded per-sample randomness, spherical geometry and
 //! eight-lane vectors.
 
+mod equal_area;
 mod frame;
 mod offset;
 mod polygon;
 mod rng;
 mod vec3x8;
 
+pub use equal_area::{SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk};
 pub use frame::Frame;
 pub use offset::{offset_ray_origin, offset_ray_origins};
 pub use polygon::lambert_polygon_irradiance;

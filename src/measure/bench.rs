@@ -7,6 +7,7 @@ use super::{ConvergencePoint, Reference, Series, error_vs_reference};
 use crate::render::{Film, RenderSettings, Renderer, Strategy};
 use crate::scene::Scene;
 use serde::Serialize;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One strategy at one budget.
@@ -39,7 +40,7 @@ pub struct BenchReport {
 /// Renders `scene` with each strategy in `strategies` (other settings from `base`) up to each budget in `spp`
 /// (ascending), measuring against `reference`. `progress` is called after every budget with (strategy, spp).
 pub fn run_bench(
-    scene: &Scene,
+    scene: &Arc<Scene>,
     reference: &Reference,
     base: RenderSettings,
     strategies: &[Strategy],
@@ -51,7 +52,7 @@ pub fn run_bench(
     let mut series = Vec::new();
     for &strategy in strategies {
         let settings = RenderSettings { strategy, ..base };
-        let renderer = Renderer::new(scene, settings);
+        let renderer = Renderer::new(scene.clone(), settings);
         let mut film = Film::new(w, h);
         let mut run = Series::new(strategy.name());
         let (mut done, mut seconds, mut dropped) = (0u32, 0.0f64, 0u64);
@@ -94,7 +95,8 @@ mod tests {
         scene.camera.width = 12;
         scene.camera.height = 12;
         let mut film = Film::new(12, 12);
-        Renderer::new(&scene, reference_settings()).render_pass(&mut film, 0, 64, &|| false);
+        let scene = Arc::new(scene);
+        Renderer::new(scene.clone(), reference_settings()).render_pass(&mut film, 0, 64, &|| false);
         let reference = Reference::from_film(&film, 0.0);
         let strategies = [Strategy::Cosine, Strategy::Emitter];
         let mut calls = 0;

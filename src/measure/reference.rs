@@ -6,7 +6,7 @@
 //! materials, camera) and the reference's spp and seed, but not the estimator under study: every unbiased strategy
 //! converges to the same image, so toggling strategies never invalidates the reference.
 
-use crate::render::{Film, Heuristic, LightTechnique, MisSettings, RenderSettings, Strategy};
+use crate::render::{Film, Heuristic, MisSettings, RenderSettings, Strategy};
 use crate::scene::{LightSelection, Scene};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -24,10 +24,9 @@ pub fn reference_settings() -> RenderSettings {
         light_selection: LightSelection::Power,
         seed: REFERENCE_SEED,
         mis: MisSettings {
-            light: LightTechnique::ProjectedSolidAngle,
+            techniques: [Strategy::ProjectedSolidAngle, Strategy::Brdf],
             heuristic: Heuristic::Power,
-            light_samples: 1,
-            brdf_samples: 1,
+            samples: [1, 1],
         },
     }
 }
@@ -302,7 +301,7 @@ mod tests {
     fn cache_round_trip_keeps_mean_and_variance() {
         let scene = small("cornell-box");
         let mut film = Film::new(8, 6);
-        Renderer::new(&scene, reference_settings()).render_pass(&mut film, 0, 8, &|| false);
+        Renderer::new(std::sync::Arc::new(scene.clone()), reference_settings()).render_pass(&mut film, 0, 8, &|| false);
         let reference = Reference::from_film(&film, 0.5);
         assert_eq!(reference.spp, 8);
         assert!(reference.noise_mse() > 0.0 && reference.noise_rel_mse() > 0.0);

@@ -1,8 +1,9 @@
-//! One sample of the scattering integral: `f_r(ω_k, ω_o) L_i(ω_k) (ω_k·n) / p(ω_k)`, or, for MIS, the weighted
-//! combination of a light and a BRDF technique.
+//! One sample of the scattering integral: `f_r(ω_k, ω_o) L_i(ω_k) (ω_k·n) / p(ω_k)`, and what finding L_i takes
+//! (tracing the sampled direction, or a shadow ray towards the sampled point on a light).
 
-use super::strategy::{DirectionSample, MisSettings, Target};
-use super::{RenderSettings, ShadingPoint, Strategy};
+use super::sink::{Outcome, SampleRecord, SampleSink};
+use super::strategy::{DirectionSample, Reached, SampleContext, Target};
+use super::{RenderSettings, ShadingPoint};
 use crate::math::{SampleRng, Vec3x8, offset_ray_origin, offset_ray_origins};
 use crate::scene::{EmitterSampler, SKIP_NONE, Scene};
 use glam::Vec3;
@@ -19,87 +20,106 @@ pub fn estimate_direct(
     rng: &mut SampleRng,
     rays: &mut u64,
 ) -> Vec3 {
-    if settings.strategy == Strategy::Mis {
-        return estimate_mis(scene, sp, &settings.mis, emitters, rng, rays);
-    }
-    let Some(s) = settings.strategy.sample(sp, scene, emitters, rng) else { return Vec3::ZERO };
-    match integrand(scene, sp, &s, rays) {
-        Some((value, _)) => value / s.pdf,
-        None => Vec3::ZERO,
+    let ctx = SampleContext { scene, emitters, mis: &settings.mis };
+    settings.strategy.estimate(&ctx, sp, rng, rays, &mut ())
+}
+
+/// The one-sample estimator for a drawn direction (or none): `f_r L_i (ω·n) / p(ω)`, reported to `sink`.
+#[inline(always)]
+pub fn one_sample<S: SampleSink>(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    s: Option<DirectionSample>,
+    rays: &mut u64,
+    sink: &mut S,
+) -> Vec3 {
+    let Some(s) = s else {
+        sink.record(SampleRecord::none(0));
+        return Vec3::ZERO;
+    };
+    let (contribution, outcome) = match integrand(scene, sp, &s, rays) {
+        Ok((value, _)) => (value / s.pdf, Outcome::Contributed),
+        Err(outcome) => (Vec3::ZERO, outcome),
+    };
+    sink.record(SampleRecord { technique: 0, wi: s.wi, pdf: s.pdf, mis_weight: 1.0, contribution, outcome });
+    contribution
+}
+
+impl SampleRecord {
+    /// A strategy that could draw no direction.
+    #[inline(always)]
+    pub fn none(technique: u8) -> Self {
+        let (wi, contribution) = (Vec3::ZERO, Vec3::ZERO);
+        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, outcome: Outcome::NoSample }
     }
 }
 
 /// `f_r L_i (ω·n)` for a sampled direction (not yet divided by the density), and the emitter triangle and point
-/// it reached. `None` where it is zero.
+/// it reached; where it is zero, why.
 #[inline]
-fn integrand(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, rays: &mut u64) -> Option<(Vec3, (u32, Vec3))> {
+pub(crate) fn integrand(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    s: &DirectionSample,
+    rays: &mut u64,
+) -> Result<(Vec3, Reached), Outcome> {
     match s.target {
         Target::Trace => {
             let (f, cos) = brdf_and_cos(sp, s)?;
             *rays += 1;
             let origin = offset_ray_origin(sp.p, sp.n);
-            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY)?;
+            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY).ok_or(Outcome::MissedLights)?;
             let li = scene.emitted(hit.triangle, -s.wi);
-            (li != Vec3::ZERO).then_some((f * li * cos, (hit.triangle, scene.hit_point(&hit))))
+            if li == Vec3::ZERO {
+                return Err(Outcome::MissedLights);
+            }
+            Ok((f * li * cos, Reached { triangle: hit.triangle, point: scene.hit_point(&hit) }))
         }
         Target::Emitter { triangle, point } => {
             let (value, n_x) = unshadowed(scene, sp, s, triangle)?;
-            visible(scene, sp.p, sp.n, (triangle, point, n_x), rays).then_some((value, (triangle, point)))
+            if !visible(scene, sp.p, sp.n, (triangle, point, n_x), rays) {
+                return Err(Outcome::Occluded);
+            }
+            Ok((value, Reached { triangle, point }))
         }
     }
 }
 
-/// f_r and ω·n for a sampled direction; `None` where the sample contributes nothing whatever arrives along ω
+/// The emitter triangle the ray from `sp` along `wi` reaches first, and where; `None` where it meets a surface
+/// that does not emit towards it, or nothing.
+pub fn reached(scene: &Scene, sp: &ShadingPoint, wi: Vec3) -> Option<Reached> {
+    let hit = scene.accel().closest_hit(offset_ray_origin(sp.p, sp.n), wi, f32::INFINITY)?;
+    (scene.emitted(hit.triangle, -wi) != Vec3::ZERO)
+        .then(|| Reached { triangle: hit.triangle, point: scene.hit_point(&hit) })
+}
+
+/// f_r and ω·n for a sampled direction; why not, where the sample contributes nothing whatever arrives along ω
 /// (below the surface, zero density, f_r = 0).
 #[inline]
-fn brdf_and_cos(sp: &ShadingPoint, s: &DirectionSample) -> Option<(Vec3, f32)> {
+fn brdf_and_cos(sp: &ShadingPoint, s: &DirectionSample) -> Result<(Vec3, f32), Outcome> {
     let cos = sp.n.dot(s.wi);
     if !(cos > 0.0 && s.pdf > 0.0) {
-        return None;
+        return Err(if cos > 0.0 { Outcome::NoSample } else { Outcome::BelowSurface });
     }
     let f = sp.material.eval_brdf(sp.n, sp.wo, s.wi);
-    (f != Vec3::ZERO).then_some((f, cos))
+    if f == Vec3::ZERO { Err(Outcome::ZeroBrdf) } else { Ok((f, cos)) }
 }
 
 /// For a direction aimed at a point on the emitter triangle `triangle`: `f_r L_e (ω·n)`, which arrives if the
-/// shadow ray gets through, and the triangle's normal (for the ray's far end). `None` where it is zero anyway.
+/// shadow ray gets through, and the triangle's normal (for the ray's far end). Why not, where it is zero anyway.
 #[inline]
-pub(super) fn unshadowed(scene: &Scene, sp: &ShadingPoint, s: &DirectionSample, triangle: u32) -> Option<(Vec3, Vec3)> {
-    let (f, cos) = brdf_and_cos(sp, s)?;
-    let le = scene.emitted(triangle, -s.wi);
-    (le != Vec3::ZERO).then(|| (f * le * cos, scene.triangles[triangle as usize].n))
-}
-
-/// Veach's multi-sample MIS estimator (see [`super::strategy::mis`]).
-fn estimate_mis(
+pub(super) fn unshadowed(
     scene: &Scene,
     sp: &ShadingPoint,
-    mis: &MisSettings,
-    emitters: Option<&EmitterSampler>,
-    rng: &mut SampleRng,
-    rays: &mut u64,
-) -> Vec3 {
-    let (n_l, n_b) = (mis.light_samples, mis.brdf_samples);
-    let mut total = Vec3::ZERO;
-    if let Some(emitters) = emitters {
-        for _ in 0..n_l {
-            let Some(s) = mis.light.sample(sp, scene, emitters, rng) else { continue };
-            if let Some((value, _)) = integrand(scene, sp, &s, rays) {
-                let p_b = sp.material.pdf_brdf(sp.n, sp.wo, s.wi);
-                let w = mis.heuristic.weight(n_l, s.pdf, n_b, p_b);
-                total += value * (w / (n_l as f32 * s.pdf));
-            }
-        }
+    s: &DirectionSample,
+    triangle: u32,
+) -> Result<(Vec3, Vec3), Outcome> {
+    let (f, cos) = brdf_and_cos(sp, s)?;
+    let le = scene.emitted(triangle, -s.wi);
+    if le == Vec3::ZERO {
+        return Err(Outcome::MissedLights);
     }
-    for _ in 0..n_b {
-        let Some(s) = Strategy::Brdf.sample(sp, scene, emitters, rng) else { continue };
-        if let Some((value, (triangle, x))) = integrand(scene, sp, &s, rays) {
-            let p_l = emitters.map_or(0.0, |e| mis.light.pdf(sp, scene, e, triangle, x, s.wi));
-            let w = if n_l == 0 { 1.0 } else { mis.heuristic.weight(n_b, s.pdf, n_l, p_l) };
-            total += value * (w / (n_b as f32 * s.pdf));
-        }
-    }
-    total
+    Ok((f * le * cos, scene.triangles[triangle as usize].n))
 }
 
 /// Shadow ray between p (normal n, on the side of x) and the point x on the emitter triangle Δ (normal n_x,

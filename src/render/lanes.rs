@@ -7,7 +7,8 @@
 //! bit, so a film does not depend on how its samples were grouped.
 
 use super::estimator::{unshadowed, visible_lanes};
-use super::{LightTechnique, ShadingPoint, Target};
+use super::strategy::SampleContext;
+use super::{ShadingPoint, Strategy, Target};
 use crate::math::{SampleRng, SampleRngLanes, Vec3x8, for_each_lane};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
@@ -122,19 +123,19 @@ pub fn estimate_emitter_lanes(
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
 
-/// [`estimate_emitter_lanes`] for any light technique, with the sampling and the BRDF lane by lane: only the
+/// [`estimate_emitter_lanes`] for any light strategy, with the sampling and the BRDF lane by lane: only the
 /// shadow rays go together. Each lane's stream `rngs[l]` continues after the camera's two uniforms. Adds the
 /// shadow rays traced to `rays`.
 #[inline]
 pub fn estimate_light_lanes(
-    scene: &Scene,
-    emitters: &EmitterSampler,
-    technique: LightTechnique,
+    ctx: &SampleContext,
+    strategy: Strategy,
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
+    let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal.
     let mut ends = [[Vec3::ZERO; LANES]; 4];
@@ -146,9 +147,9 @@ pub fn estimate_light_lanes(
         let wo = -dirs.lane(l);
         let sp = ShadingPoint::new(scene.hit_point(&hit), tri.n, wo, scene.material_of(hit.triangle));
         emitted[l] = scene.emitted(hit.triangle, wo);
-        let Some(s) = technique.sample(&sp, scene, emitters, &mut rngs[l]) else { continue };
+        let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
         let Target::Emitter { triangle, point } = s.target else { continue };
-        let Some((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
+        let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
         reflected[l] = value / s.pdf;
         (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
         groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);

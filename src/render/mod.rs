@@ -7,12 +7,14 @@ mod lanes;
 mod output;
 mod pass;
 mod shading;
+pub mod sink;
 pub mod strategy;
 
 pub use cones::PixelCones;
-pub use estimator::{SEGMENT_END, estimate_direct};
+pub use estimator::{SEGMENT_END, estimate_direct, reached, visible};
 pub use film::{Film, PixelAccum};
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;
-pub use strategy::{DirectionSample, Heuristic, LightTechnique, MisSettings, Strategy, Target};
+pub use sink::{Outcome, SampleRecord, SampleSink};
+pub use strategy::{DirectionSample, Domain, Heuristic, MisSettings, Reached, SampleContext, Strategy, Target};

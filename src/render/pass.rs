@@ -3,8 +3,8 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
-use super::strategy::MisSettings;
-use super::{Film, LightTechnique, PixelAccum, PixelCones, ShadingPoint, Strategy, estimate_direct};
+use super::strategy::{MisSettings, SampleContext};
+use super::{Film, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
@@ -64,9 +64,10 @@ impl std::ops::AddAssign for PassStats {
     }
 }
 
-/// Renders a scene with fixed settings.
-pub struct Renderer<'a> {
-    scene: &'a Scene,
+/// Renders a scene with fixed settings, pass after pass. It owns what is built once per scene and settings and
+/// kept across passes: the light selection's p_Δ tables and the pixel cones.
+pub struct Renderer {
+    scene: Arc<Scene>,
     settings: RenderSettings,
     emitters: Option<EmitterSampler>,
     camera: CameraBasis,
@@ -74,21 +75,35 @@ pub struct Renderer<'a> {
     cones: Arc<PixelCones>,
 }
 
-impl<'a> Renderer<'a> {
-    pub fn new(scene: &'a Scene, settings: RenderSettings) -> Self {
-        Self::with_camera(scene, settings, &scene.camera)
+impl Renderer {
+    pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
+        let camera = scene.camera;
+        Self::with_camera(scene, settings, &camera)
     }
 
     /// Renders through another camera than the scene's (e.g. a low-resolution preview).
-    pub fn with_camera(scene: &'a Scene, settings: RenderSettings, camera: &Camera) -> Self {
+    pub fn with_camera(scene: Arc<Scene>, settings: RenderSettings, camera: &Camera) -> Self {
         Self {
+            emitters: EmitterSampler::new(&scene, settings.light_selection),
             scene,
             settings,
-            emitters: EmitterSampler::new(scene, settings.light_selection),
             camera: camera.basis(),
             size: (camera.width, camera.height),
             cones: Arc::new(PixelCones::new(camera)),
         }
+    }
+
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// What its strategies read besides the shading point.
+    pub fn context(&self) -> SampleContext<'_> {
+        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis }
     }
 
     /// The pixel cones this renderer found and keeps, to give to a later renderer of the same scene geometry
@@ -148,7 +163,7 @@ impl<'a> Renderer<'a> {
                         }
                     }
                 } else {
-                    let cones = self.cones.row(self.scene, &self.camera, y as u32, width);
+                    let cones = self.cones.row(&self.scene, &self.camera, y as u32, width);
                     for ((x, acc), cone) in row.iter_mut().enumerate().zip(cones) {
                         let streams = streams(x);
                         for group in (first..first + count).step_by(LANES) {
@@ -207,13 +222,14 @@ impl<'a> Renderer<'a> {
             })),
         };
         *rays += n as u64;
-        match (self.settings.strategy.light_technique(), &self.emitters) {
-            (Some(LightTechnique::Area), Some(emitters)) => {
-                estimate_emitter_lanes(self.scene, emitters, &dirs, &hits, &mut rngs, rays)
+        let strategy = self.settings.strategy;
+        match (strategy, &self.emitters) {
+            (Strategy::Emitter, Some(emitters)) => {
+                estimate_emitter_lanes(&self.scene, emitters, &dirs, &hits, &mut rngs, rays)
             }
-            (Some(technique), Some(emitters)) => {
+            (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                estimate_light_lanes(self.scene, emitters, technique, &dirs, &hits, &mut rngs, rays)
+                estimate_light_lanes(&self.context(), strategy, &dirs, &hits, &mut rngs, rays)
             }
             _ => std::array::from_fn(|l| {
                 hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays))
@@ -230,7 +246,7 @@ impl<'a> Renderer<'a> {
         let material = &self.scene.materials[tri.material as usize];
         let sp = ShadingPoint::new(p, tri.n, wo, material);
         let emitted = self.scene.emitted(hit.triangle, wo);
-        emitted + estimate_direct(self.scene, &sp, &self.settings, self.emitters.as_ref(), rng, rays)
+        emitted + self.settings.strategy.estimate(&self.context(), &sp, rng, rays, &mut ())
     }
 }
 
@@ -244,40 +260,49 @@ mod tests {
     #[test]
     fn kept_cones_are_taken_for_the_same_camera_only() {
         let (_, scene, camera) = every_bundled_scene(24, 16).find(|(name, ..)| *name == "veach-mis").expect("bundled");
-        let first = Renderer::with_camera(&scene, RenderSettings::default(), &camera);
+        let scene = Arc::new(scene);
+        let first = Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera);
         let mut kept = Film::new(camera.width, camera.height);
         first.render_pass(&mut kept, 0, 8, &|| false);
-        let second = Renderer::with_camera(&scene, RenderSettings::default(), &camera).with_cones(first.cones());
+        let second = Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera).with_cones(first.cones());
         assert!(Arc::ptr_eq(&second.cones(), &first.cones()), "same camera: the cones are taken");
         second.render_pass(&mut kept, 8, 8, &|| false);
         let mut fresh = Film::new(camera.width, camera.height);
-        Renderer::with_camera(&scene, RenderSettings::default(), &camera).render_pass(&mut fresh, 0, 16, &|| false);
+        Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera).render_pass(
+            &mut fresh,
+            0,
+            16,
+            &|| false,
+        );
         assert!(kept.pixels == fresh.pixels, "kept cones change the film");
         let moved = Camera { eye: camera.eye + Vec3::new(0.1, 0.0, 0.0), ..camera };
-        let third = Renderer::with_camera(&scene, RenderSettings::default(), &moved).with_cones(first.cones());
+        let third = Renderer::with_camera(scene, RenderSettings::default(), &moved).with_cones(first.cones());
         assert!(!Arc::ptr_eq(&third.cones(), &first.cones()), "another camera: its own cones");
     }
 
     /// Thirteen samples per pixel in one pass (through each pixel's cone, eight lanes then five), in thirteen
     /// passes of one (a full traversal and the one-sample estimator each) and in passes of three and ten give the
-    /// same film bit for bit: on every bundled scene, with every light selection for `emitter`, with the other
-    /// light strategies (all three take the eight-lane estimators) and with strategies that trace BRDF rays.
+    /// same film bit for bit: on every bundled scene, with every registered strategy (the light strategies take
+    /// the eight-lane estimators), and with every light selection for the light strategies.
     #[test]
     fn any_split_into_passes_gives_the_same_film() {
-        let mut settings: Vec<RenderSettings> = LightSelection::ALL
+        let settings: Vec<RenderSettings> = Strategy::ALL
             .into_iter()
-            .map(|light_selection| RenderSettings {
-                strategy: Strategy::Emitter,
-                light_selection,
-                ..Default::default()
+            .flat_map(|strategy| {
+                let selections =
+                    if strategy.samples_lights() { &LightSelection::ALL[..] } else { &[LightSelection::Power] };
+                selections.iter().map(move |&light_selection| RenderSettings {
+                    strategy,
+                    light_selection,
+                    ..Default::default()
+                })
             })
             .collect();
-        let others = [Strategy::SolidAngle, Strategy::ProjectedSolidAngle, Strategy::Brdf, Strategy::Mis];
-        settings.extend(others.map(|strategy| RenderSettings { strategy, ..Default::default() }));
         for (name, scene, camera) in every_bundled_scene(48, 36) {
+            let scene = Arc::new(scene);
             for settings in &settings {
                 let settings = RenderSettings { seed: 3, ..*settings };
-                let renderer = Renderer::with_camera(&scene, settings, &camera);
+                let renderer = Renderer::with_camera(scene.clone(), settings, &camera);
                 let film = |passes: &[u32]| {
                     let mut film = Film::new(camera.width, camera.height);
                     let mut first = 0;

@@ -1,96 +1,59 @@
-//! The light strategies: each picks an emitter triangle Δ with p_Δ and then a direction towards it, and can
-//! evaluate its density for any direction that reaches an emitter (multiple importance sampling needs that).
+//! What the light strategies share: each picks an emitter triangle Δ with p_Δ and then a direction towards it,
+//! `p(ω) = p_Δ p(ω | Δ)`, and can evaluate that density for any direction that reaches an emitter (multiple
+//! importance sampling and the probe need it). A light strategy implements [`TriangleSampler`] (the part given
+//! Δ) and its [`super::DirectionStrategy`] calls [`sample_light`] and [`light_pdf`].
 
-use super::{DirectionSample, Target, emitter, projected_solid_angle, solid_angle};
+use super::{DirectionSample, Reached, SampleContext, Target};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
-use crate::scene::{EmitterSampler, Scene, Triangle};
+use crate::scene::Triangle;
 use glam::Vec3;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum LightTechnique {
-    /// Uniform point on Δ (`emitter`).
-    Area,
-    /// Uniform direction in the spherical triangle (`solid-angle`).
-    SolidAngle,
-    /// Direction ∝ (ω·n) over Δ (`projected-solid-angle`).
-    ProjectedSolidAngle,
+/// Directions towards one emitter triangle Δ, seen from a shading point.
+pub trait TriangleSampler {
+    /// A direction towards Δ, its density w.r.t. solid angle given Δ, and the point on Δ it aims at.
+    fn sample_triangle(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)>;
+
+    /// The density given Δ of `wi`, which meets Δ at `x`.
+    fn triangle_pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32;
 }
 
-impl LightTechnique {
-    pub const ALL: [LightTechnique; 3] =
-        [LightTechnique::Area, LightTechnique::SolidAngle, LightTechnique::ProjectedSolidAngle];
-
-    /// The name of the stand-alone strategy.
-    pub fn name(self) -> &'static str {
-        match self {
-            LightTechnique::Area => "emitter",
-            LightTechnique::SolidAngle => "solid-angle",
-            LightTechnique::ProjectedSolidAngle => "projected-solid-angle",
-        }
+/// Picks Δ with p_Δ, then a direction towards it: density `p_Δ p(ω | Δ)`.
+#[inline(always)]
+pub fn sample_light<T: TriangleSampler>(
+    ctx: &SampleContext,
+    sp: &ShadingPoint,
+    rng: &mut SampleRng,
+) -> Option<DirectionSample> {
+    let emitters = ctx.emitters?;
+    let (triangle, p_delta) = emitters.pick(ctx.scene, sp.p, rng.uniform())?;
+    let tri = &ctx.scene.triangles[triangle as usize];
+    if !faces(tri, sp.p) {
+        return None; // the back of a one-sided emitter: L_i = 0
     }
+    let (wi, pdf, point) = T::sample_triangle(sp, tri, rng)?;
+    let pdf = p_delta * pdf;
+    (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { wi, pdf, target: Target::Emitter { triangle, point } })
+}
 
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|t| t.name() == name)
+/// Density w.r.t. solid angle of drawing `wi`, which reaches the emitter triangle `via`: `p_Δ p(ω | Δ)`.
+#[inline]
+pub fn light_pdf<T: TriangleSampler>(ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+    let (Some(emitters), Some(Reached { triangle, point })) = (ctx.emitters, via) else { return 0.0 };
+    let tri = &ctx.scene.triangles[triangle as usize];
+    if !faces(tri, sp.p) {
+        return 0.0;
     }
-
-    #[inline(always)]
-    pub fn sample(
-        self,
-        sp: &ShadingPoint,
-        scene: &Scene,
-        emitters: &EmitterSampler,
-        rng: &mut SampleRng,
-    ) -> Option<DirectionSample> {
-        let (triangle, p_delta) = emitters.pick(scene, sp.p, rng.uniform())?;
-        let tri = &scene.triangles[triangle as usize];
-        if !faces(tri, sp.p) {
-            return None; // the back of a one-sided emitter: L_i = 0
-        }
-        let (wi, pdf, point) = match self {
-            LightTechnique::Area => emitter::sample(sp, tri, rng)?,
-            LightTechnique::SolidAngle => solid_angle::sample(sp, tri, rng)?,
-            LightTechnique::ProjectedSolidAngle => projected_solid_angle::sample(sp, tri, rng)?,
-        };
-        let pdf = p_delta * pdf;
-        (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample {
-            wi,
-            pdf,
-            target: Target::Emitter { triangle, point },
-        })
+    let p_delta = emitters.p_delta(ctx.scene, triangle, sp.p);
+    if p_delta == 0.0 {
+        return 0.0;
     }
-
-    /// Density w.r.t. solid angle of drawing `wi`, which reaches emitter triangle `triangle` at `x`.
-    #[inline]
-    pub fn pdf(
-        self,
-        sp: &ShadingPoint,
-        scene: &Scene,
-        emitters: &EmitterSampler,
-        triangle: u32,
-        x: Vec3,
-        wi: Vec3,
-    ) -> f32 {
-        let tri = &scene.triangles[triangle as usize];
-        if !faces(tri, sp.p) {
-            return 0.0;
-        }
-        let p_delta = emitters.p_delta(scene, triangle, sp.p);
-        if p_delta == 0.0 {
-            return 0.0;
-        }
-        p_delta
-            * match self {
-                LightTechnique::Area => emitter::pdf(sp, tri, x, wi),
-                LightTechnique::SolidAngle => solid_angle::pdf(sp, tri, x, wi),
-                LightTechnique::ProjectedSolidAngle => projected_solid_angle::pdf(sp, tri, x, wi),
-            }
-    }
+    p_delta * T::triangle_pdf(sp, tri, point, wi)
 }
 
 /// Whether p is on the emitting side of the triangle's plane.
 #[inline]
-fn faces(tri: &Triangle, p: Vec3) -> bool {
+pub fn faces(tri: &Triangle, p: Vec3) -> bool {
     tri.n.dot(p - tri.v[0]) > 0.0
 }
 

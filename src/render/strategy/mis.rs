@@ -1,16 +1,21 @@
-//! Multiple importance sampling (Veach & Guibas 1995; Veach 1997 ch. 9), multi-sample form: per pixel sample,
-//! n_l directions from a light strategy and n_b from BRDF sampling, each weighted by
+//! Multiple importance sampling (Veach & Guibas 1995; Veach 1997 ch. 9), as a combinator of any two techniques
+//! of the registry, multi-sample form: per pixel sample, n_0 directions from technique 0 (by default a light
+//! strategy) and n_1 from technique 1 (by default BRDF sampling), each weighted by
 //! `w_i(ω) = (n_i p_i(ω))^β / Σ_j (n_j p_j(ω))^β` (β = 1: balance heuristic, β = 2: power heuristic):
 //!
-//! `F = Σ_{k<n_l} w_l f L cos / (n_l p_l) + Σ_{k<n_b} w_b f L cos / (n_b p_b)`.
+//! `F = Σ_{k<n_0} w_0 f L cos / (n_0 p_0) + Σ_{k<n_1} w_1 f L cos / (n_1 p_1)`.
 //!
 //! The weights of the two techniques sum to one for every direction, so F is unbiased; a weight that is not
-//! finite is 0 (Mitsuba's rule).
+//! finite is 0 (Mitsuba's rule). As a (sample, pdf) pair — what the probe draws and the chi-square tests check —
+//! MIS is the mixture its directions come from: technique i with probability n_i / (n_0 + n_1), so
+//! `p(ω) = (n_0 p_0(ω) + n_1 p_1(ω)) / (n_0 + n_1)`.
 
-use super::light::LightTechnique;
-
-pub const DESCRIPTION: &str = "multiple importance sampling: a light strategy and BRDF sampling, weighted (Veach 1995)";
-pub const PDF: &str = "w_i = (n_i p_i)^β / Σ_j (n_j p_j)^β,  β = 1 balance, 2 power";
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy};
+use crate::math::SampleRng;
+use crate::render::ShadingPoint;
+use crate::render::estimator::integrand;
+use crate::render::sink::{Outcome, SampleRecord, SampleSink};
+use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Heuristic {
@@ -48,18 +53,101 @@ impl Heuristic {
 /// How MIS combines its techniques.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MisSettings {
-    pub light: LightTechnique,
+    /// The two techniques (any strategies but MIS itself), sampled in this order.
+    pub techniques: [Strategy; 2],
     pub heuristic: Heuristic,
-    /// Light samples per pixel sample (n_l).
-    pub light_samples: u32,
-    /// BRDF samples per pixel sample (n_b).
-    pub brdf_samples: u32,
+    /// Directions per pixel sample from each technique (n_0, n_1).
+    pub samples: [u32; 2],
 }
 
 impl Default for MisSettings {
     fn default() -> Self {
-        Self { light: LightTechnique::Area, heuristic: Heuristic::Power, light_samples: 1, brdf_samples: 1 }
+        Self { techniques: [Strategy::Emitter, Strategy::Brdf], heuristic: Heuristic::Power, samples: [1, 1] }
     }
+}
+
+impl MisSettings {
+    /// Whether these settings describe an estimator: two techniques other than MIS, at least one direction.
+    pub fn is_valid(&self) -> bool {
+        self.techniques.iter().all(|t| t.domain() != Domain::Mixture) && self.samples.iter().sum::<u32>() > 0
+    }
+
+    /// A short label: `emitter×1 + brdf×1, power`.
+    pub fn label(&self) -> String {
+        let [a, b] = self.techniques;
+        let [na, nb] = self.samples;
+        format!("{}×{na} + {}×{nb}, {}", a.name(), b.name(), self.heuristic.name())
+    }
+}
+
+pub struct Mis;
+
+impl DirectionStrategy for Mis {
+    const NAME: &'static str = "mis";
+    const DESCRIPTION: &'static str =
+        "multiple importance sampling: two techniques (a light strategy and BRDF sampling), weighted (Veach 1995)";
+    const PDF: &'static str = "w_i = (n_i p_i)^β / Σ_j (n_j p_j)^β,  β = 1 balance, 2 power";
+    const DOMAIN: Domain = Domain::Mixture;
+
+    /// A direction of the mixture: technique 0 with probability n_0 / (n_0 + n_1), reusing the choosing uniform.
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        let [t0, t1] = valid_techniques(ctx)?;
+        let [n0, n1] = ctx.mis.samples;
+        let chosen = if rng.uniform() * ((n0 + n1) as f32) < n0 as f32 { t0 } else { t1 };
+        let s = chosen.sample(ctx, sp, rng)?;
+        let via = match s.target {
+            super::Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
+            super::Target::Trace => crate::render::estimator::reached(ctx.scene, sp, s.wi),
+        };
+        let pdf = self.pdf(ctx, sp, s.wi, via);
+        (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { pdf, ..s })
+    }
+
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        let Some([t0, t1]) = valid_techniques(ctx) else { return 0.0 };
+        let [n0, n1] = ctx.mis.samples.map(|n| n as f32);
+        (n0 * t0.pdf(ctx, sp, wi, via) + n1 * t1.pdf(ctx, sp, wi, via)) / (n0 + n1)
+    }
+
+    /// Veach's multi-sample estimator.
+    #[inline]
+    fn estimate<S: SampleSink>(
+        &self,
+        ctx: &SampleContext,
+        sp: &ShadingPoint,
+        rng: &mut SampleRng,
+        rays: &mut u64,
+        sink: &mut S,
+    ) -> Vec3 {
+        let Some(techniques) = valid_techniques(ctx) else { return Vec3::ZERO };
+        let (heuristic, n) = (ctx.mis.heuristic, ctx.mis.samples);
+        let mut total = Vec3::ZERO;
+        for i in 0..2 {
+            let (own, other) = (techniques[i], techniques[1 - i]);
+            for _ in 0..n[i] {
+                let Some(s) = own.sample(ctx, sp, rng) else {
+                    sink.record(SampleRecord::none(i as u8));
+                    continue;
+                };
+                let (contribution, w, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+                    Ok((value, via)) => {
+                        let p_other = other.pdf(ctx, sp, s.wi, Some(via));
+                        let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
+                        (value * (w / (n[i] as f32 * s.pdf)), w, Outcome::Contributed)
+                    }
+                    Err(outcome) => (Vec3::ZERO, 0.0, outcome),
+                };
+                total += contribution;
+                let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
+                sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, outcome });
+            }
+        }
+        total
+    }
+}
+
+fn valid_techniques(ctx: &SampleContext) -> Option<[Strategy; 2]> {
+    ctx.mis.is_valid().then_some(ctx.mis.techniques)
 }
 
 #[cfg(test)]

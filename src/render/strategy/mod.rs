@@ -1,5 +1,11 @@
-//! The sampling strategies: each is one small unit that draws a direction ω_k and knows its density p(ω_k), so
-//! that `f_r L_i (ω_k·n) / p(ω_k)` estimates the scattering integral. All of them estimate the same integral.
+//! The sampling strategies. Each is one file implementing one contract, [`DirectionStrategy`]: it draws a
+//! direction ω_k and knows its density p(ω) for any ω, so that `f_r L_i (ω_k·n) / p(ω_k)` estimates the
+//! scattering integral; all of them estimate the same integral. The [`registry!`] below lists them, and
+//! everything that lists strategies (the CLI, the viewer, `illumlab strategies`, the tests) iterates
+//! [`Strategy::ALL`].
+//!
+//! Adding a strategy: a new file here with a unit struct implementing [`DirectionStrategy`], one line in the
+//! registry, and its tests (the chi-square, unbiasedness and pass tests iterate the registry by themselves).
 
 mod brdf;
 mod cosine;
@@ -10,13 +16,23 @@ mod projected_solid_angle;
 mod solid_angle;
 mod uniform;
 
-pub use light::LightTechnique;
 pub use mis::{Heuristic, MisSettings};
 
 use super::ShadingPoint;
+use super::sink::SampleSink;
 use crate::math::SampleRng;
 use crate::scene::{EmitterSampler, Scene};
 use glam::Vec3;
+
+/// What a strategy may read besides the shading point: the scene and the state built once per scene and
+/// settings by the renderer that owns it (the light selection's p_Δ tables, MIS's techniques).
+#[derive(Clone, Copy)]
+pub struct SampleContext<'a> {
+    pub scene: &'a Scene,
+    /// p_Δ; `None` in a scene without emitters.
+    pub emitters: Option<&'a EmitterSampler>,
+    pub mis: &'a MisSettings,
+}
 
 /// A sampled incident direction and how to find the radiance arriving along it.
 #[derive(Clone, Copy, Debug)]
@@ -38,99 +54,138 @@ pub enum Target {
     Emitter { triangle: u32, point: Vec3 },
 }
 
-/// A strategy by its command-line name.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Strategy {
-    Uniform,
-    Cosine,
-    Brdf,
-    Emitter,
-    SolidAngle,
-    ProjectedSolidAngle,
-    Mis,
+/// An emitter triangle a direction reaches, and where: what a light strategy's density depends on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reached {
+    pub triangle: u32,
+    pub point: Vec3,
+}
+
+/// Which directions a strategy draws, which decides how its density is evaluated over the sphere and how its
+/// samples are binned in a chi-square test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Domain {
+    /// Directions anywhere on the sphere (those below the surface contribute nothing); `pdf` ignores `via`.
+    Hemisphere,
+    /// Directions towards emitter triangles: the density of ω is that of reaching `via`, the emitter triangle ω
+    /// meets; over the sphere it is the sum over every facing emitter triangle ω passes through.
+    Lights,
+    /// A mixture of two techniques of either domain (MIS).
+    Mixture,
+}
+
+/// The contract every strategy implements: a (sample, pdf) pair with its name, description and formula.
+pub trait DirectionStrategy {
+    /// The command-line name.
+    const NAME: &'static str;
+    /// One line: what the strategy samples.
+    const DESCRIPTION: &'static str;
+    /// The density in the lecture's notation.
+    const PDF: &'static str;
+    const DOMAIN: Domain;
+
+    /// Draws ω_k. `None`: no sample could be taken (it counts as zero).
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample>;
+
+    /// The density w.r.t. solid angle of drawing `wi`; `via` is the emitter triangle and point `wi` reaches
+    /// (light strategies are 0 without one). Finite and ≥ 0.
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32;
+
+    /// One sample of the scattering integral at `sp`, reporting every direction it evaluates to `sink`. The
+    /// one-sample estimator `f_r L_i (ω·n) / p(ω)` unless a strategy combines several directions (MIS).
+    #[inline(always)]
+    fn estimate<S: SampleSink>(
+        &self,
+        ctx: &SampleContext,
+        sp: &ShadingPoint,
+        rng: &mut SampleRng,
+        rays: &mut u64,
+        sink: &mut S,
+    ) -> Vec3 {
+        let s = self.sample(ctx, sp, rng);
+        super::estimator::one_sample(ctx.scene, sp, s, rays, sink)
+    }
+}
+
+/// Generates [`Strategy`], the registry: one line per strategy, `Variant => path::Type`.
+macro_rules! registry {
+    ($($variant:ident => $ty:path),* $(,)?) => {
+        /// A strategy of the registry, by its command-line name.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum Strategy {
+            $($variant),*
+        }
+
+        impl Strategy {
+            /// Every registered strategy, in the order the CLI and the viewer list them.
+            pub const ALL: [Strategy; [$(stringify!($variant)),*].len()] = [$(Strategy::$variant),*];
+
+            pub fn name(self) -> &'static str {
+                match self { $(Strategy::$variant => <$ty as DirectionStrategy>::NAME),* }
+            }
+
+            pub fn description(self) -> &'static str {
+                match self { $(Strategy::$variant => <$ty as DirectionStrategy>::DESCRIPTION),* }
+            }
+
+            pub fn pdf_formula(self) -> &'static str {
+                match self { $(Strategy::$variant => <$ty as DirectionStrategy>::PDF),* }
+            }
+
+            pub fn domain(self) -> Domain {
+                match self { $(Strategy::$variant => <$ty as DirectionStrategy>::DOMAIN),* }
+            }
+
+            /// [`DirectionStrategy::sample`].
+            #[inline(always)]
+            pub fn sample(self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+                match self { $(Strategy::$variant => $ty.sample(ctx, sp, rng)),* }
+            }
+
+            /// [`DirectionStrategy::pdf`].
+            #[inline]
+            pub fn pdf(self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+                match self { $(Strategy::$variant => $ty.pdf(ctx, sp, wi, via)),* }
+            }
+
+            /// [`DirectionStrategy::estimate`].
+            #[inline(always)]
+            pub fn estimate<S: SampleSink>(
+                self,
+                ctx: &SampleContext,
+                sp: &ShadingPoint,
+                rng: &mut SampleRng,
+                rays: &mut u64,
+                sink: &mut S,
+            ) -> Vec3 {
+                match self { $(Strategy::$variant => $ty.estimate(ctx, sp, rng, rays, sink)),* }
+            }
+        }
+    };
+}
+
+registry! {
+    Uniform => uniform::Uniform,
+    Cosine => cosine::Cosine,
+    Brdf => brdf::Brdf,
+    Emitter => emitter::Emitter,
+    SolidAngle => solid_angle::SolidAngle,
+    ProjectedSolidAngle => projected_solid_angle::ProjectedSolidAngle,
+    Mis => mis::Mis,
 }
 
 impl Strategy {
-    pub const ALL: [Strategy; 7] = [
-        Strategy::Uniform,
-        Strategy::Cosine,
-        Strategy::Brdf,
-        Strategy::Emitter,
-        Strategy::SolidAngle,
-        Strategy::ProjectedSolidAngle,
-        Strategy::Mis,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Strategy::Uniform => "uniform",
-            Strategy::Cosine => "cosine",
-            Strategy::Brdf => "brdf",
-            Strategy::Emitter => "emitter",
-            Strategy::SolidAngle => "solid-angle",
-            Strategy::ProjectedSolidAngle => "projected-solid-angle",
-            Strategy::Mis => "mis",
-        }
-    }
-
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|s| s.name() == name)
     }
 
-    /// One line: what the strategy samples.
-    pub fn description(self) -> &'static str {
-        match self {
-            Strategy::Uniform => uniform::DESCRIPTION,
-            Strategy::Cosine => cosine::DESCRIPTION,
-            Strategy::Brdf => brdf::DESCRIPTION,
-            Strategy::Emitter => emitter::DESCRIPTION,
-            Strategy::SolidAngle => solid_angle::DESCRIPTION,
-            Strategy::ProjectedSolidAngle => projected_solid_angle::DESCRIPTION,
-            Strategy::Mis => mis::DESCRIPTION,
-        }
+    /// The strategies that can be a technique of MIS: all but MIS itself.
+    pub fn techniques() -> impl Iterator<Item = Strategy> {
+        Self::ALL.into_iter().filter(|s| s.domain() != Domain::Mixture)
     }
 
-    /// The density in the lecture's notation.
-    pub fn pdf_formula(self) -> &'static str {
-        match self {
-            Strategy::Uniform => uniform::PDF,
-            Strategy::Cosine => cosine::PDF,
-            Strategy::Brdf => brdf::PDF,
-            Strategy::Emitter => emitter::PDF,
-            Strategy::SolidAngle => solid_angle::PDF,
-            Strategy::ProjectedSolidAngle => projected_solid_angle::PDF,
-            Strategy::Mis => mis::PDF,
-        }
-    }
-
-    /// The light technique of a light strategy.
-    pub fn light_technique(self) -> Option<LightTechnique> {
-        match self {
-            Strategy::Emitter => Some(LightTechnique::Area),
-            Strategy::SolidAngle => Some(LightTechnique::SolidAngle),
-            Strategy::ProjectedSolidAngle => Some(LightTechnique::ProjectedSolidAngle),
-            _ => None,
-        }
-    }
-
-    /// Draws ω_k. `None`: no sample could be taken (it counts as zero). MIS draws several directions and is
-    /// evaluated by the estimator instead.
-    #[inline]
-    pub fn sample(
-        self,
-        sp: &ShadingPoint,
-        scene: &Scene,
-        emitters: Option<&EmitterSampler>,
-        rng: &mut SampleRng,
-    ) -> Option<DirectionSample> {
-        match self {
-            Strategy::Uniform => uniform::sample(sp, rng),
-            Strategy::Cosine => cosine::sample(sp, rng),
-            Strategy::Brdf => brdf::sample(sp, rng),
-            Strategy::Emitter | Strategy::SolidAngle | Strategy::ProjectedSolidAngle => {
-                self.light_technique()?.sample(sp, scene, emitters?, rng)
-            }
-            Strategy::Mis => None,
-        }
+    /// Whether the strategy draws directions towards emitter triangles.
+    pub fn samples_lights(self) -> bool {
+        self.domain() == Domain::Lights
     }
 }

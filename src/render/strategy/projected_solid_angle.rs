@@ -3,39 +3,60 @@
 //! constant `(k_d/π) L Ω⊥`: its only variance is visibility and the choice of triangle. Exact by rejection from
 //! spherical-triangle samples; area sampling where that would be inefficient (see [`ProjectedPlan`]).
 
-use super::light::{area_pdf_solid_angle, hit_plane};
+use super::emitter::Emitter;
+use super::light::{TriangleSampler, area_pdf_solid_angle, hit_plane, light_pdf, sample_light};
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::sampling::{ProjectedPlan, projected_triangle_pdf, sample_projected_triangle};
 use crate::scene::Triangle;
 use glam::Vec3;
 
-pub const DESCRIPTION: &str = "directions proportional to cos θ over a light triangle (exact): ideal for diffuse";
-pub const PDF: &str = "p(ω) = p_Δ (ω·n) / Ω_proj,  Ω_proj = ½ Σ Θ_i (n·γ_i)";
+pub struct ProjectedSolidAngle;
 
 fn plan(sp: &ShadingPoint, tri: &Triangle) -> ProjectedPlan {
     let [a, b, c] = tri.v;
     ProjectedPlan::new(sp.p, sp.n, a, b, c)
 }
 
-#[inline]
-pub fn sample(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
-    match plan(sp, tri) {
-        ProjectedPlan::Invisible => None,
-        ProjectedPlan::Area => super::emitter::sample(sp, tri, rng),
-        ProjectedPlan::Rejection { projected, cos_max, .. } => {
-            let wi = sample_projected_triangle(rng, sp.p, sp.n, tri.v, cos_max)?;
-            let x = hit_plane(sp.p, wi, tri)?;
-            Some((wi, projected_triangle_pdf(wi.dot(sp.n), projected), x))
+impl TriangleSampler for ProjectedSolidAngle {
+    #[inline]
+    fn sample_triangle(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
+        match plan(sp, tri) {
+            ProjectedPlan::Invisible => None,
+            ProjectedPlan::Area => Emitter::sample_triangle(sp, tri, rng),
+            ProjectedPlan::Rejection { projected, cos_max, .. } => {
+                let wi = sample_projected_triangle(rng, sp.p, sp.n, tri.v, cos_max)?;
+                let x = hit_plane(sp.p, wi, tri)?;
+                Some((wi, projected_triangle_pdf(wi.dot(sp.n), projected), x))
+            }
+        }
+    }
+
+    #[inline]
+    fn triangle_pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
+        match plan(sp, tri) {
+            ProjectedPlan::Invisible => 0.0,
+            ProjectedPlan::Area => area_pdf_solid_angle(sp.p, tri, x, wi),
+            ProjectedPlan::Rejection { projected, .. } => projected_triangle_pdf(wi.dot(sp.n), projected),
         }
     }
 }
 
-#[inline]
-pub fn pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
-    match plan(sp, tri) {
-        ProjectedPlan::Invisible => 0.0,
-        ProjectedPlan::Area => area_pdf_solid_angle(sp.p, tri, x, wi),
-        ProjectedPlan::Rejection { projected, .. } => projected_triangle_pdf(wi.dot(sp.n), projected),
+impl DirectionStrategy for ProjectedSolidAngle {
+    const NAME: &'static str = "projected-solid-angle";
+    const DESCRIPTION: &'static str =
+        "directions proportional to cos θ over a light triangle (exact): ideal for diffuse";
+    const PDF: &'static str = "p(ω) = p_Δ (ω·n) / Ω_proj,  Ω_proj = ½ Σ Θ_i (n·γ_i)";
+    const DOMAIN: Domain = Domain::Lights;
+
+    #[inline]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        sample_light::<Self>(ctx, sp, rng)
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        light_pdf::<Self>(ctx, sp, wi, via)
     }
 }

@@ -3,7 +3,9 @@
 //! harder than a far one. Where Ω_Δ < 3·10⁻⁴ sr or > 6.22 sr (float precision; pbrt-v4's limits) it samples the
 //! area instead, with that density.
 
-use super::light::{area_pdf_solid_angle, hit_plane};
+use super::emitter::Emitter;
+use super::light::{TriangleSampler, area_pdf_solid_angle, hit_plane, light_pdf, sample_light};
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::sampling::{
@@ -13,28 +15,46 @@ use crate::sampling::{
 use crate::scene::Triangle;
 use glam::Vec3;
 
-pub const DESCRIPTION: &str = "uniform directions in the spherical triangle of a light triangle (Arvo 1995)";
-pub const PDF: &str = "p(ω) = p_Δ / Ω_Δ   (area sampling where Ω_Δ < 3e-4 or > 6.22 sr)";
+pub struct SolidAngle;
 
 fn spherical(solid_angle: f32) -> bool {
     (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&solid_angle)
 }
 
-#[inline]
-pub fn sample(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
-    let [a, b, c] = tri.v;
-    let omega = spherical_triangle_area(sp.p, a, b, c);
-    if !spherical(omega) {
-        return super::emitter::sample(sp, tri, rng);
+impl TriangleSampler for SolidAngle {
+    #[inline]
+    fn sample_triangle(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
+        let [a, b, c] = tri.v;
+        let omega = spherical_triangle_area(sp.p, a, b, c);
+        if !spherical(omega) {
+            return Emitter::sample_triangle(sp, tri, rng);
+        }
+        let wi = sample_spherical_triangle(rng.uniform_2d(), sp.p, a, b, c)?;
+        let x = hit_plane(sp.p, wi, tri)?;
+        Some((wi, spherical_triangle_pdf(omega), x))
     }
-    let wi = sample_spherical_triangle(rng.uniform_2d(), sp.p, a, b, c)?;
-    let x = hit_plane(sp.p, wi, tri)?;
-    Some((wi, spherical_triangle_pdf(omega), x))
+
+    #[inline]
+    fn triangle_pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
+        let [a, b, c] = tri.v;
+        let omega = spherical_triangle_area(sp.p, a, b, c);
+        if spherical(omega) { spherical_triangle_pdf(omega) } else { area_pdf_solid_angle(sp.p, tri, x, wi) }
+    }
 }
 
-#[inline]
-pub fn pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
-    let [a, b, c] = tri.v;
-    let omega = spherical_triangle_area(sp.p, a, b, c);
-    if spherical(omega) { spherical_triangle_pdf(omega) } else { area_pdf_solid_angle(sp.p, tri, x, wi) }
+impl DirectionStrategy for SolidAngle {
+    const NAME: &'static str = "solid-angle";
+    const DESCRIPTION: &'static str = "uniform directions in the spherical triangle of a light triangle (Arvo 1995)";
+    const PDF: &'static str = "p(ω) = p_Δ / Ω_Δ   (area sampling where Ω_Δ < 3e-4 or > 6.22 sr)";
+    const DOMAIN: Domain = Domain::Lights;
+
+    #[inline]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        sample_light::<Self>(ctx, sp, rng)
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        light_pdf::<Self>(ctx, sp, wi, via)
+    }
 }

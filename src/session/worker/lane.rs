@@ -1,7 +1,8 @@
 //! One image being refined: its settings, its film and what it took.
 
-use crate::render::{Film, PassStats, RenderSettings};
-use crate::scene::Camera;
+use crate::render::{Film, PassStats, PixelCones, RenderSettings, Renderer};
+use crate::scene::{Camera, Scene};
+use std::sync::Arc;
 use std::time::Duration;
 
 /// One image being refined.
@@ -16,6 +17,9 @@ pub(super) struct Lane {
     pub(super) generation: u64,
     /// Whether the preview of this generation was published.
     pub(super) previewed: bool,
+    /// The renderer of its passes, kept while the scene and the settings are the same (it owns the state built
+    /// per scene and settings).
+    renderer: Option<Renderer>,
 }
 
 impl Lane {
@@ -29,7 +33,28 @@ impl Lane {
             elapsed: Duration::ZERO,
             generation: 0,
             previewed: false,
+            renderer: None,
         }
+    }
+
+    /// The renderer for `scene` and this lane's settings, to be given back with [`Lane::keep`]: the kept one if
+    /// it is for both, else a new one, which takes `cones` if they are for its camera.
+    pub(super) fn take_renderer(&mut self, scene: &Arc<Scene>, cones: Option<&Arc<PixelCones>>) -> Renderer {
+        let settings = self.settings;
+        match self.renderer.take() {
+            Some(r) if Arc::ptr_eq(r.scene(), scene) && *r.settings() == settings => r,
+            _ => {
+                let renderer = Renderer::new(scene.clone(), settings);
+                match cones {
+                    Some(cones) => renderer.with_cones(cones.clone()),
+                    None => renderer,
+                }
+            }
+        }
+    }
+
+    pub(super) fn keep(&mut self, renderer: Renderer) {
+        self.renderer = Some(renderer);
     }
 
     pub(super) fn reset(&mut self, camera: &Camera, generation: u64) {

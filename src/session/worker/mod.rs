@@ -399,7 +399,7 @@ impl State {
         let generation = lane.generation;
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
-        let renderer = Renderer::with_camera(&self.scene, lane.settings, &small);
+        let renderer = Renderer::with_camera(self.scene.clone(), lane.settings, &small);
         let mut film = Film::new(small.width, small.height);
         let stats = pool.install(|| renderer.render_pass(&mut film, 0, 1, &cancelled));
         if cancelled() {
@@ -448,12 +448,10 @@ impl State {
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
         let start = Instant::now();
-        let mut renderer = Renderer::new(&self.scene, lane.settings);
-        if let Some(cones) = &self.cones {
-            renderer = renderer.with_cones(cones.clone());
-        }
+        let renderer = lane.take_renderer(&self.scene, self.cones.as_ref());
         let stats = pool.install(|| renderer.render_pass(&mut lane.film, lane.spp, count, &cancelled));
         self.cones = Some(renderer.cones());
+        lane.keep(renderer);
         if cancelled() {
             return; // partial: the pending command restarts this film
         }

@@ -18,6 +18,8 @@ pub(super) struct ReferenceJob {
     scratch: Film,
     spp: u32,
     elapsed: Duration,
+    /// Kept from pass to pass: a new scene starts a new job.
+    renderer: Renderer,
 }
 
 impl State {
@@ -57,6 +59,7 @@ impl State {
             scratch: Film::new(w, h),
             spp: 0,
             elapsed: Duration::ZERO,
+            renderer: Renderer::new(self.scene.clone(), reference_settings()),
         });
         self.publish_reference(ReferenceStatus::Rendering { spp: 0, target, elapsed: Duration::ZERO });
     }
@@ -70,8 +73,7 @@ impl State {
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
         job.scratch.clear();
         let start = Instant::now();
-        let renderer = Renderer::new(&self.scene, reference_settings());
-        pool.install(|| renderer.render_pass(&mut job.scratch, job.spp, 1, &cancelled));
+        pool.install(|| job.renderer.render_pass(&mut job.scratch, job.spp, 1, &cancelled));
         if cancelled() {
             return;
         }

@@ -56,7 +56,7 @@ fn refines_then_restarts_on_a_new_strategy() {
     assert!(g.generation > f.generation);
     // Restarted: the film holds exactly samples 0..spp of the new strategy, however many passes ran.
     let mut film = Film::new(32, 32);
-    Renderer::new(&small_scene(), g.settings).render_pass(&mut film, 0, g.spp, &|| false);
+    Renderer::new(small_scene(), g.settings).render_pass(&mut film, 0, g.spp, &|| false);
     assert_eq!(g.radiance, film.means(), "accumulation restarted");
 }
 
@@ -71,7 +71,7 @@ fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
     assert!(worker.take_frame().is_none(), "idle at the target");
     // The progressive film equals a one-shot render of the same samples.
     let mut film = Film::new(32, 32);
-    Renderer::new(&scene, RenderSettings::default()).render_pass(&mut film, 0, 5, &|| false);
+    Renderer::new(scene, RenderSettings::default()).render_pass(&mut film, 0, 5, &|| false);
     assert_eq!(f.radiance, film.means());
 }
 
@@ -82,7 +82,7 @@ fn kept_pixel_cones_give_the_one_shot_image_and_follow_the_camera() {
     let scene = small_scene();
     let one_shot = |scene: &Scene| {
         let mut film = Film::new(32, 32);
-        Renderer::new(scene, RenderSettings::default()).render_pass(&mut film, 0, 12, &|| false);
+        Renderer::new(Arc::new(scene.clone()), RenderSettings::default()).render_pass(&mut film, 0, 12, &|| false);
         film.means()
     };
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});

@@ -1,0 +1,299 @@
+//! Chi-square goodness of fit of a strategy's sampling at the probed point against its own `pdf(ω)`, as Nori's
+//! warptest does it: the samples' histogram over cells beside the pdf integrated over each cell, Pearson's
+//! statistic after pooling the cells that expect fewer than 5 samples, and its p-value. Hemisphere strategies
+//! and MIS are binned over the whole sphere in equal-solid-angle cells of (cos θ, φ) about the normal; light
+//! strategies on their own domain, cells of each light triangle (a direction is binned where it meets the
+//! triangle it was aimed at), where their density is smooth however small the light looks. A sample that could
+//! not be drawn falls in one more cell, which expects `N (1 − ∫p)`. MIS draws from its two techniques, n_i
+//! directions of technique i per pixel sample: each technique is tested on its own domain with its share of the
+//! draws, and the smaller p-value, Šidák-corrected for two, is MIS's.
+
+use super::adaptive::{Refinement, integrate_triangle};
+use super::density::density;
+use crate::math::{Frame, SampleRng};
+use crate::render::strategy::light::faces;
+use crate::render::{Domain, Reached, SampleContext, ShadingPoint, Strategy, Target};
+use glam::{DVec2, DVec3, Vec3};
+use serde::Serialize;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// The result of one test.
+#[derive(Clone, Debug, Serialize)]
+pub struct ChiSquare {
+    pub samples: u64,
+    pub statistic: f64,
+    pub dof: usize,
+    pub p_value: f64,
+    /// ∫ p dω over the cells: the strategy's coverage (1 unless some draws fail by design).
+    pub integral: f64,
+    /// "sphere" or "light triangles".
+    pub binning: &'static str,
+    /// Per cell: samples observed and expected (before pooling), the failure cell last.
+    #[serde(skip)]
+    pub cells: Vec<(f64, f64)>,
+}
+
+/// The p-value below which a single test fails, at a family-wise level of 1% over `tests` tests (Šidák).
+pub fn level(tests: usize) -> f64 {
+    1.0 - 0.99f64.powf(1.0 / tests.max(1) as f64)
+}
+
+const Z_CELLS: usize = 24;
+const PHI_CELLS: usize = 48;
+/// Each light triangle is cut into 4^k cells.
+const TRIANGLE_DEPTH: u32 = 2;
+
+/// Tests `samples` draws of `strategy` at `sp` (streams of `seed`) against its density.
+pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, samples: u64, seed: u64) -> ChiSquare {
+    if strategy.domain() == Domain::Mixture {
+        let [n0, n1] = ctx.mis.samples.map(|n| n as u64);
+        let parts: Vec<(ChiSquare, u64)> = ctx
+            .mis
+            .techniques
+            .iter()
+            .zip([n0, n1])
+            .filter(|(_, n)| *n > 0)
+            .enumerate()
+            .map(|(i, (&t, n))| (chi_square(ctx, sp, t, (samples * n / (n0 + n1)).max(1), seed + i as u64), n))
+            .collect();
+        let k = parts.len() as i32;
+        let min_p = parts.iter().map(|(c, _)| c.p_value).fold(1.0, f64::min);
+        return ChiSquare {
+            samples: parts.iter().map(|(c, _)| c.samples).sum(),
+            statistic: parts.iter().map(|(c, _)| c.statistic).sum(),
+            dof: parts.iter().map(|(c, _)| c.dof).sum(),
+            p_value: 1.0 - (1.0 - min_p).powi(k),
+            integral: parts.iter().map(|(c, n)| c.integral * *n as f64).sum::<f64>() / (n0 + n1).max(1) as f64,
+            binning: "per technique",
+            cells: parts.into_iter().flat_map(|(c, _)| c.cells).collect(),
+        };
+    }
+    chi_square_against(ctx, sp, strategy, samples, seed, &|w, via| match via {
+        Some(_) if strategy.domain() == Domain::Lights => strategy.pdf(ctx, sp, w, via),
+        _ => density(ctx, sp, strategy, w),
+    })
+}
+
+/// [`chi_square`] against another density (to show that a wrong one fails): `pdf(ω, via)`.
+pub fn chi_square_against(
+    ctx: &SampleContext,
+    sp: &ShadingPoint,
+    strategy: Strategy,
+    samples: u64,
+    seed: u64,
+    pdf: &(dyn Fn(Vec3, Option<Reached>) -> f32 + Sync),
+) -> ChiSquare {
+    let (binning, mut cells) = match strategy.domain() {
+        Domain::Lights => ("light triangles", light_cells(ctx, sp, pdf)),
+        _ => ("sphere", sphere_cells(sp, pdf)),
+    };
+    let frame = Frame::from_z(sp.n);
+    let lights: Vec<u32> = ctx.scene.emitters.clone();
+    let failed = cells.len();
+    let mut observed = vec![0.0; cells.len() + 1];
+    for k in 0..samples {
+        let mut rng = SampleRng::new(seed, u64::MAX - 11, k);
+        let cell = strategy.sample(ctx, sp, &mut rng).and_then(|s| match (strategy.domain(), s.target) {
+            (Domain::Lights, Target::Emitter { triangle, point }) => {
+                let slot = lights.iter().position(|&t| t == triangle)?;
+                let tri = &ctx.scene.triangles[triangle as usize];
+                Some(slot * cells_per_triangle() + triangle_cell(tri.v, point))
+            }
+            (Domain::Lights, Target::Trace) => None,
+            _ => Some(sphere_cell(frame.to_local(s.wi))),
+        });
+        observed[cell.unwrap_or(failed)] += 1.0;
+    }
+    let integral: f64 = cells.iter().sum();
+    cells.push((1.0 - integral).max(0.0));
+    let (statistic, dof) = pearson(&observed, &cells, samples as f64);
+    let p_value = if statistic.is_finite() {
+        ChiSquared::new(dof.max(1) as f64).map(|d| d.sf(statistic)).unwrap_or(0.0)
+    } else {
+        0.0
+    };
+    let cells = observed.into_iter().zip(cells.iter().map(|e| e * samples as f64)).collect();
+    ChiSquare { samples, statistic, dof, p_value, integral, binning, cells }
+}
+
+fn cells_per_triangle() -> usize {
+    4usize.pow(TRIANGLE_DEPTH)
+}
+
+/// The cell of a local direction: cos θ in Z_CELLS equal bands over [−1, 1], φ in PHI_CELLS (equal solid angle).
+fn sphere_cell(w: Vec3) -> usize {
+    let z = (((w.z + 1.0) * 0.5 * Z_CELLS as f32) as usize).min(Z_CELLS - 1);
+    let phi = w.y.atan2(w.x).rem_euclid(std::f32::consts::TAU);
+    let p = ((phi / std::f32::consts::TAU * PHI_CELLS as f32) as usize).min(PHI_CELLS - 1);
+    z * PHI_CELLS + p
+}
+
+/// The probability of each sphere cell, `∫ p dω` with dω = d(cos θ) dφ, adaptively.
+fn sphere_cells(sp: &ShadingPoint, pdf: &(dyn Fn(Vec3, Option<Reached>) -> f32 + Sync)) -> Vec<f64> {
+    use rayon::prelude::*;
+    let frame = Frame::from_z(sp.n);
+    let f = |z: f64, phi: f64| {
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let w = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
+        pdf(frame.to_world(w), None) as f64
+    };
+    let (dz, dphi) = (2.0 / Z_CELLS as f64, std::f64::consts::TAU / PHI_CELLS as f64);
+    (0..Z_CELLS * PHI_CELLS)
+        .into_par_iter()
+        .map(|i| {
+            let lo = DVec2::new(-1.0 + (i / PHI_CELLS) as f64 * dz, (i % PHI_CELLS) as f64 * dphi);
+            let whole = gauss(&f, lo, lo + DVec2::new(dz, dphi));
+            adaptive_rect(&f, lo, lo + DVec2::new(dz, dphi), whole, 1e-7, 0)
+        })
+        .collect()
+}
+
+/// 3×3 Gauss–Legendre on a rectangle (interior nodes: a density that jumps on an edge, the horizon, is fine).
+fn gauss(f: &impl Fn(f64, f64) -> f64, lo: DVec2, hi: DVec2) -> f64 {
+    const X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
+    const W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
+    let (c, h) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+    let mut sum = 0.0;
+    for (xa, wa) in X.iter().zip(W) {
+        for (xb, wb) in X.iter().zip(W) {
+            sum += wa * wb * f(c.x + h.x * xa, c.y + h.y * xb);
+        }
+    }
+    sum * h.x * h.y
+}
+
+fn adaptive_rect(f: &impl Fn(f64, f64) -> f64, lo: DVec2, hi: DVec2, whole: f64, tol: f64, depth: u32) -> f64 {
+    let m = (lo + hi) * 0.5;
+    let quads = [
+        (lo, m),
+        (DVec2::new(m.x, lo.y), DVec2::new(hi.x, m.y)),
+        (DVec2::new(lo.x, m.y), DVec2::new(m.x, hi.y)),
+        (m, hi),
+    ];
+    let parts = quads.map(|(a, b)| gauss(f, a, b));
+    let sum: f64 = parts.iter().sum();
+    if (sum - whole).abs() <= tol || depth >= 7 {
+        return sum;
+    }
+    quads.iter().zip(parts).map(|(&(a, b), part)| adaptive_rect(f, a, b, part, tol * 0.25, depth + 1)).sum()
+}
+
+/// The cell of point x of triangle (a, b, c): the leaf of TRIANGLE_DEPTH midpoint subdivisions that holds it.
+fn triangle_cell([a, b, c]: [Vec3; 3], x: Vec3) -> usize {
+    // Barycentric coordinates, then descend: the corner children 0..2 or the middle 3.
+    let (e1, e2, d) = ((b - a).as_dvec3(), (c - a).as_dvec3(), (x - a).as_dvec3());
+    let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+    let (d1, d2) = (d.dot(e1), d.dot(e2));
+    let det = d11 * d22 - d12 * d12;
+    let v = ((d22 * d1 - d12 * d2) / det).clamp(0.0, 1.0);
+    let w = ((d11 * d2 - d12 * d1) / det).clamp(0.0, 1.0);
+    let mut bary = [1.0 - v - w, v, w];
+    let mut cell = 0;
+    for _ in 0..TRIANGLE_DEPTH {
+        // Children of (A, B, C): [A, AB, CA], [AB, B, BC], [CA, BC, C], [AB, BC, CA] (as in `adaptive`).
+        let (child, next) = if bary[0] >= 0.5 {
+            (0, [2.0 * bary[0] - 1.0, 2.0 * bary[1], 2.0 * bary[2]])
+        } else if bary[1] >= 0.5 {
+            (1, [2.0 * bary[0], 2.0 * bary[1] - 1.0, 2.0 * bary[2]])
+        } else if bary[2] >= 0.5 {
+            (2, [2.0 * bary[0], 2.0 * bary[1], 2.0 * bary[2] - 1.0])
+        } else {
+            // The middle child (AB, BC, CA): weights of its corners.
+            (3, [1.0 - 2.0 * bary[2], 1.0 - 2.0 * bary[0], 1.0 - 2.0 * bary[1]])
+        };
+        cell = cell * 4 + child;
+        bary = next;
+    }
+    cell
+}
+
+/// The sub-triangles of (a, b, c) in [`triangle_cell`]'s order.
+fn triangle_leaves(tri: [DVec3; 3], depth: u32) -> Vec<[DVec3; 3]> {
+    if depth == 0 {
+        return vec![tri];
+    }
+    let [a, b, c] = tri;
+    let (ab, bc, ca) = ((a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5);
+    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]
+        .into_iter()
+        .flat_map(|t| triangle_leaves(t, depth - 1))
+        .collect()
+}
+
+/// The probability of each light-triangle cell: `∫ p(ω(x)) (n_Δ·−ω) / ‖x − p‖² dA`, for every emitter triangle
+/// in the scene's order (zero for those p does not face).
+fn light_cells(
+    ctx: &SampleContext,
+    sp: &ShadingPoint,
+    pdf: &(dyn Fn(Vec3, Option<Reached>) -> f32 + Sync),
+) -> Vec<f64> {
+    use rayon::prelude::*;
+    let p = sp.p.as_dvec3();
+    ctx.scene
+        .emitters
+        .par_iter()
+        .flat_map_iter(|&t| {
+            let tri = &ctx.scene.triangles[t as usize];
+            let facing = faces(tri, sp.p);
+            let n_light = tri.n.as_dvec3();
+            triangle_leaves(tri.v.map(|v| v.as_dvec3()), TRIANGLE_DEPTH).into_iter().map(move |leaf| {
+                if !facing {
+                    return 0.0;
+                }
+                let mut f = |x: DVec3| {
+                    let d = x - p;
+                    let r2 = d.length_squared();
+                    let w = d / r2.sqrt();
+                    let cos_light = -n_light.dot(w);
+                    if !(cos_light > 0.0) {
+                        return DVec3::ZERO;
+                    }
+                    let via = Reached { triangle: t, point: x.as_vec3() };
+                    DVec3::splat(pdf(w.as_vec3(), Some(via)) as f64 * cos_light / r2)
+                };
+                let r = Refinement { tolerance: 1e-8, max_depth: 10, max_nodes: 200_000 };
+                integrate_triangle(leaf, &mut f, r, &mut 0).x
+            })
+        })
+        .collect()
+}
+
+/// Pearson's statistic after pooling every cell expecting fewer than 5 samples into one, and its degrees of
+/// freedom.
+fn pearson(observed: &[f64], expected_fraction: &[f64], n: f64) -> (f64, usize) {
+    let (mut stat, mut cells) = (0.0, 0usize);
+    let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
+    for (&o, &e) in observed.iter().zip(expected_fraction) {
+        let e = e * n;
+        if e < 5.0 {
+            pooled_obs += o;
+            pooled_exp += e;
+        } else {
+            stat += (o - e) * (o - e) / e;
+            cells += 1;
+        }
+    }
+    if pooled_exp > 0.0 {
+        stat += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
+        cells += 1;
+    } else if pooled_obs > 0.0 {
+        stat = f64::INFINITY; // samples where the density says none can be
+    }
+    (stat, cells.saturating_sub(1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_cells_match_the_leaves() {
+        let tri = [Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.3, 1.5, 0.0)];
+        let leaves = triangle_leaves(tri.map(|v| v.as_dvec3()), TRIANGLE_DEPTH);
+        for (i, leaf) in leaves.iter().enumerate() {
+            let centroid = ((leaf[0] + leaf[1] + leaf[2]) / 3.0).as_vec3();
+            assert_eq!(triangle_cell(tri, centroid), i);
+        }
+        let _ = DVec3::ZERO;
+    }
+}
