@@ -309,3 +309,56 @@ fn identical_estimators_differ_nowhere_and_error_views_switch() {
     h.step();
     assert_eq!(h.state().view_note(), Some("zero everywhere"));
 }
+
+/// A click on the image at `pos` (press and release in separate frames, as a person's).
+fn click_at(h: &mut Harness<'_, Viewer>, pos: egui::Pos2, modifiers: egui::Modifiers) {
+    h.event(egui::Event::ModifiersChanged(modifiers));
+    h.hover_at(pos);
+    h.step();
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers });
+        h.step();
+    }
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.step();
+}
+
+/// The probe end to end: `I` and a click on the image probe that pixel (Ctrl-click too); switching the strategy
+/// updates the probe's samples and density; the chi-square button shows a p-value.
+#[test]
+fn clicking_the_image_probes_that_pixel_and_follows_the_strategy() {
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.step();
+    let rect = h.state().image_rect().expect("the image is drawn");
+    let at = |x: f32, y: f32| rect.min + egui::vec2(x + 0.5, y + 0.5) * (rect.width() / 48.0);
+    h.key_press(egui::Key::I);
+    h.step();
+    click_at(&mut h, at(12.0, 44.0), egui::Modifiers::NONE);
+    step_until(&mut h, "a probe of pixel 12,44", |v| {
+        v.probe_view().is_some_and(|p| p.request.pixel == (12, 44) && p.point.is_some() && !p.lanes.is_empty())
+    });
+    let view = h.state().probe_view().expect("a probe");
+    let (emitter, _) = &view.lanes[0];
+    assert_eq!(emitter.strategy, Strategy::Emitter);
+    assert!(emitter.run.records.iter().any(|r| r.outcome == illumlab::render::Outcome::Contributed));
+    let emitter_density = emitter.maps.density.clone();
+    // The strategy radio updates the probe: other samples, another density.
+    h.get_by_label("2 cosine").click();
+    h.step();
+    step_until(&mut h, "a cosine probe", |v| v.probe_view().is_some_and(|p| p.lanes[0].0.strategy == Strategy::Cosine));
+    let cosine = &h.state().probe_view().expect("a probe").lanes[0].0;
+    assert_ne!(cosine.maps.density, emitter_density, "the density layer follows the strategy");
+    assert!(h.query_by_label_contains("cosine — p(ω) = (ω·n)/π").is_some(), "the panel names the strategy and its pdf");
+    // The chi-square button.
+    h.get_by_label("Chi-square here").click();
+    h.step();
+    step_until(&mut h, "a chi-square result", |v| v.probe_view().is_some_and(|p| p.lanes[0].0.chi2.is_some()));
+    h.step();
+    assert!(h.query_by_label_contains("at 1%), ").is_some(), "the p-value is shown");
+    // Ctrl-click elsewhere, probe mode off.
+    h.key_press(egui::Key::I);
+    h.step();
+    click_at(&mut h, at(30.0, 40.0), egui::Modifiers::COMMAND);
+    step_until(&mut h, "a probe of pixel 30,40", |v| v.probe_view().is_some_and(|p| p.request.pixel == (30, 40)));
+}

@@ -6,6 +6,7 @@ mod controls;
 mod convergence;
 mod loader;
 mod orbit;
+mod probe;
 mod shortcuts;
 mod status;
 mod viewer;
@@ -30,6 +31,8 @@ pub struct ViewOptions {
     pub reference_spp: u32,
     /// Open the convergence plot.
     pub plot: bool,
+    /// Open the probe at this pixel.
+    pub probe: Option<(u32, u32)>,
 }
 
 /// Opens the window, already rendering.
@@ -59,6 +62,9 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
             viewer.set_view(options.view);
             if options.plot {
                 viewer.show_convergence_plot();
+            }
+            if let Some(pixel) = options.probe {
+                viewer.set_probe_pixel(pixel);
             }
             viewer.bind_repaint(cc.egui_ctx.clone());
             Ok(Box::new(viewer))

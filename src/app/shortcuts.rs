@@ -17,6 +17,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("V", "next view: image, error maps"),
     ("P", "convergence plot"),
     ("F", "hide / show the panels"),
+    ("I", "probe mode on / off (then click a point); hold I and hover to probe"),
+    ("Ctrl + click", "probe the point under the cursor"),
     ("F1 or ?", "this help"),
     ("left drag", "orbit"),
     ("right or middle drag, shift + drag", "pan"),
@@ -37,6 +39,10 @@ pub fn handle(v: &mut Viewer, ui: &mut egui::Ui) {
         {
             v.set_strategy(s);
         }
+    }
+    if pressed(Key::I) {
+        v.probe.mode = !v.probe.mode;
+        v.probe.open |= v.probe.mode;
     }
     if pressed(Key::Space) {
         v.set_paused(!v.paused);

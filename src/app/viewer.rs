@@ -75,6 +75,8 @@ pub struct Viewer {
     /// Start of the previous UI frame and the recent intervals between frames (painting included).
     last_ui_start: Option<Instant>,
     ui_intervals: Vec<Duration>,
+    /// The probe panel and its thread.
+    pub(super) probe: super::probe::ProbeUi,
 }
 
 impl Viewer {
@@ -85,6 +87,7 @@ impl Viewer {
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get().saturating_sub(1).max(1));
         let settings = RenderSettings::default();
         let worker = Worker::spawn(scene.clone(), settings, threads, notify);
+        let probe = super::probe::ProbeUi::new(notifier(&repaint));
         let camera = scene.camera;
         let mut viewer = Self {
             worker,
@@ -132,6 +135,7 @@ impl Viewer {
             trace: std::env::var_os("ILLUMLAB_TRACE").is_some(),
             last_ui_start: None,
             ui_intervals: Vec::new(),
+            probe,
         };
         viewer.note_restart();
         viewer
@@ -190,6 +194,7 @@ impl Viewer {
         }
         self.poll_loading();
         self.take_frames();
+        self.poll_probe(ui.ctx());
         super::shortcuts::handle(self, ui);
         if !self.hide_panels {
             egui::Panel::bottom("status").show(ui, |ui| super::status::status_ui(self, ui));
@@ -200,6 +205,7 @@ impl Viewer {
         egui::CentralPanel::default().show(ui, |ui| super::viewport::viewport_ui(self, ui));
         super::shortcuts::help_window(self, ui);
         super::convergence::convergence_window(self, ui);
+        super::probe::probe_window(self, ui);
         if self.loading.is_some() || self.frame.is_none() {
             ui.ctx().request_repaint_after(Duration::from_millis(30));
         }
@@ -350,8 +356,9 @@ impl Viewer {
     }
 
     pub(super) fn set_material(&mut self, index: usize, material: Material) {
-        if let Some(m) = Arc::make_mut(&mut self.scene).materials.get_mut(index)
-            && *m != material
+        // Only a change copies the scene (which the worker and the probe share).
+        if self.scene.materials.get(index).is_some_and(|m| *m != material)
+            && let Some(m) = Arc::make_mut(&mut self.scene).materials.get_mut(index)
         {
             *m = material;
             self.send_restarting(Command::SetMaterial { index, material });
@@ -399,6 +406,17 @@ impl Viewer {
             Ok(paths) => {
                 self.message = Some(format!("saved {} (+ .exr, .json)", paths.png.display()));
                 self.error = None;
+                match self.export_probe() {
+                    Some(Ok(probes)) => {
+                        self.message = Some(format!(
+                            "saved {} (+ .exr, .json) and {} probe pictures",
+                            paths.png.display(),
+                            probes.len()
+                        ))
+                    }
+                    Some(Err(e)) => self.error = Some(format!("probe not saved: {e}")),
+                    None => {}
+                }
             }
             Err(e) => self.error = Some(format!("screenshot not saved: {e}")),
         }

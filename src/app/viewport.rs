@@ -74,6 +74,17 @@ pub fn viewport_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         legend(v, &painter, bar);
     }
 
+    if let Some((x, y)) = v.probe_marker() {
+        for r in &rects {
+            let at = r.min + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * scale;
+            let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(90, 200, 255));
+            painter.circle_stroke(at, 7.0, stroke);
+            painter.hline(at.x - 12.0..=at.x - 4.0, at.y, stroke);
+            painter.hline(at.x + 4.0..=at.x + 12.0, at.y, stroke);
+            painter.vline(at.x, at.y - 12.0..=at.y - 4.0, stroke);
+            painter.vline(at.x, at.y + 4.0..=at.y + 12.0, stroke);
+        }
+    }
     for (i, response) in responses.iter().enumerate() {
         pointer(v, ui, response, rects[i], scale, size);
     }
@@ -153,6 +164,20 @@ fn legend(v: &Viewer, painter: &egui::Painter, bar: egui::Rect) {
 
 /// Camera and picking on one image rect.
 fn pointer(v: &mut Viewer, ui: &egui::Ui, response: &egui::Response, rect: egui::Rect, scale: f32, size: egui::Vec2) {
+    // The probe: a click in probe mode, Ctrl-click, or hovering with I held.
+    let pixel_at = |pos: egui::Pos2| {
+        let local = (pos - rect.min) / scale;
+        (local.x >= 0.0 && local.y >= 0.0).then(|| (local.x as u32, local.y as u32))
+    };
+    let probing_click = response.clicked() && (v.probe.mode || ui.input(|i| i.modifiers.command));
+    let probing_hover =
+        response.hovered() && ui.input(|i| i.key_down(egui::Key::I)) && !ui.ctx().egui_wants_keyboard_input();
+    if (probing_click || probing_hover)
+        && let Some(p) = response.interact_pointer_pos().or(response.hover_pos()).and_then(pixel_at)
+    {
+        v.set_probe_pixel(p);
+        return;
+    }
     if response.double_clicked() {
         v.reset_camera();
         return;

@@ -106,6 +106,9 @@ pub struct ViewArgs {
     /// Open the convergence plot.
     #[arg(long)]
     pub plot: bool,
+    /// Open the probe at pixel X,Y (column from the left, row from the top).
+    #[arg(long, value_parser = probe::parse_pixel)]
+    pub probe: Option<(u32, u32)>,
 }
 
 /// The options of `--strategy mis`.
@@ -226,6 +229,7 @@ pub fn run(command: Command) -> Result<()> {
             view: args.view,
             reference_spp: args.reference_spp,
             plot: args.plot,
+            probe: args.probe,
         }),
     }
 }

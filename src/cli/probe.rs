@@ -46,7 +46,7 @@ pub struct ProbeArgs {
     pub json: bool,
 }
 
-fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_pixel(s: &str) -> Result<(u32, u32), String> {
     let (x, y) = s.split_once(',').ok_or("expected X,Y, e.g. 120,200")?;
     match (x.trim().parse(), y.trim().parse()) {
         (Ok(x), Ok(y)) => Ok((x, y)),

@@ -36,7 +36,8 @@ impl Default for Layers {
 }
 
 /// The name of the projection, for captions.
-pub const PROJECTION: &str = "Lambert azimuthal equal-area (disk area ∝ solid angle; centre = n, rim = horizon)";
+pub const PROJECTION: &str =
+    "Lambert azimuthal equal-area projection: disk areas are solid angles (dω = 2 dA); centre = n, rim = horizon";
 
 /// Decades of the log colour scale of the density disks.
 pub const DECADES: f32 = 4.0;

@@ -2,6 +2,7 @@
 //! reference, and the export of what it shows. The viewer in [`crate::app`] is a shell over it.
 
 pub mod comparison;
+pub mod probe;
 pub mod snapshot;
 pub mod views;
 pub mod worker;
