@@ -41,3 +41,15 @@ shoot_compare() { # name warm-up-seconds seconds scene args…
 shoot_compare split 45 25 veach-mis --strategy emitter --compare brdf --target-spp 256 --reference-spp 256 --plot
 shoot_compare errors 1 15 cornell-box --strategy emitter --compare cosine --view std-error --target-spp 64 --exposure 1
 shoot_compare plot 50 30 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2
+shoot_probe() { # name seconds scene args…
+  local out="screenshots/viewer-probe-$1.png" wait=$2 scene=$3; shift 3
+  xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
+    '$bin' view '$scene' $* & pid=\$!
+    sleep $wait
+    import -window root '$out'
+    kill \$pid; wait \$pid 2>/dev/null || true"
+  echo "$out"
+}
+shoot_probe cornell-box-mis 10 cornell-box --strategy mis --exposure 1 --probe 60,225
+shoot_probe veach-mis-mis 10 veach-mis --strategy mis --probe 90,200
+shoot_probe veach-mis-emitter 10 veach-mis --strategy emitter --probe 90,200

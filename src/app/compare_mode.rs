@@ -188,6 +188,12 @@ impl Viewer {
             Ok(folder) => {
                 self.message = Some(format!("saved the comparison in {}", folder.display()));
                 self.error = None;
+                // The probe's pictures and numbers go in the same folder.
+                if let Some(view) = self.probe.view.as_ref()
+                    && let Err(e) = view.export(&folder)
+                {
+                    self.error = Some(format!("probe not saved: {e}"));
+                }
             }
             Err(e) => self.error = Some(format!("comparison not saved: {e}")),
         }

@@ -71,7 +71,7 @@ pub struct Viewer {
     /// Recent UI frame times (for the status bar).
     pub(super) ui_frame_times: Vec<Duration>,
     /// `ILLUMLAB_TRACE` set: print latencies and frame times on stderr (for scripts/measure-viewer.sh).
-    trace: bool,
+    pub(super) trace: bool,
     /// Start of the previous UI frame and the recent intervals between frames (painting included).
     last_ui_start: Option<Instant>,
     ui_intervals: Vec<Duration>,

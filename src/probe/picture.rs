@@ -40,7 +40,7 @@ pub const PROJECTION: &str =
     "Lambert azimuthal equal-area projection: disk areas are solid angles (dω = 2 dA); centre = n, rim = horizon";
 
 /// Decades of the log colour scale of the density disks.
-pub const DECADES: f32 = 4.0;
+pub const DECADES: f32 = 6.0;
 
 /// The integrand and the density on a grid of disk pixels (row-major, `size`², NaN outside the disk).
 #[derive(Clone, Debug)]
