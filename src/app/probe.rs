@@ -208,7 +208,10 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         let width = ui.available_width().min(picture.width as f32 * 1.2);
         let size = egui::vec2(width, width * picture.height as f32 / picture.width as f32);
         ui.image((texture.id(), size));
-        ui.small("left: integrand / L_o · middle: density p(ω) (same log scale) · right: their ratio (white = ideal, red = too rare: fireflies) · dots: last samples by weight f L cos/p relative to L_o (blue low, red high; grey = zero; rings = MIS's 2nd technique)");
+        ui.small("left: integrand / L_o · middle: density p(ω) (same log scale) · right: their ratio (white = ideal, red = too rare: fireflies) · dots: last samples by weight f L cos/p relative to L_o (blue low, red high; grey = zero; rings = MIS's 2nd technique; MIS dots grow with their weight)");
+        if report.chi2.is_some() {
+            ui.small("chi-square rows: draws observed per cell · counts the pdf expects (same log scale) · residual (o − e)/√e from −4 (blue) to +4 (red); MIS: one row per technique");
+        }
         numbers_ui(ui, report);
     }
     if let Some(rows) = &view.table {

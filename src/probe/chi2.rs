@@ -31,6 +31,11 @@ pub struct ChiSquare {
     /// Per cell: samples observed and expected (before pooling), the failure cell last.
     #[serde(skip)]
     pub cells: Vec<(f64, f64)>,
+    /// The technique whose draws were binned.
+    #[serde(skip)]
+    pub strategy: Option<Strategy>,
+    /// MIS: the test of each technique.
+    pub parts: Vec<ChiSquare>,
 }
 
 /// The p-value below which a single test fails, at a family-wise level of 1% over `tests` tests (Šidák).
@@ -65,7 +70,9 @@ pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, sa
             p_value: 1.0 - (1.0 - min_p).powi(k),
             integral: parts.iter().map(|(c, n)| c.integral * *n as f64).sum::<f64>() / (n0 + n1).max(1) as f64,
             binning: "per technique",
-            cells: parts.into_iter().flat_map(|(c, _)| c.cells).collect(),
+            cells: Vec::new(),
+            strategy: Some(strategy),
+            parts: parts.into_iter().map(|(c, _)| c).collect(),
         };
     }
     chi_square_against(ctx, sp, strategy, samples, seed, &|w, via| match via {
@@ -113,7 +120,70 @@ pub fn chi_square_against(
         0.0
     };
     let cells = observed.into_iter().zip(cells.iter().map(|e| e * samples as f64)).collect();
-    ChiSquare { samples, statistic, dof, p_value, integral, binning, cells }
+    ChiSquare { samples, statistic, dof, p_value, integral, binning, cells, strategy: Some(strategy), parts: Vec::new() }
+}
+
+/// The cell a direction falls in, for a test binned as `strategy`'s are: a sphere cell, or the cell of the first
+/// facing emitter triangle it passes through (`None` if it meets none).
+fn cell_of(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, wi: Vec3) -> Option<usize> {
+    if strategy.domain() != Domain::Lights {
+        return Some(sphere_cell(Frame::from_z(sp.n).to_local(wi)));
+    }
+    let scene = ctx.scene;
+    let nearest = scene
+        .emitters
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| faces(&scene.triangles[**t as usize], sp.p))
+        .filter_map(|(slot, &t)| {
+            let tri = &scene.triangles[t as usize];
+            super::density::intersect(sp.p, wi, tri.v).map(|x| (slot, tri.v, x, (x - sp.p).length_squared()))
+        })
+        .min_by(|a, b| a.3.total_cmp(&b.3))?;
+    Some(nearest.0 * cells_per_triangle() + triangle_cell(nearest.1, nearest.2))
+}
+
+impl ChiSquare {
+    /// The test as Nori's warptest shows it, on the hemisphere disks of the probe's picture: the draws observed
+    /// per cell, the counts the pdf expects (same log scale), and the residual (o − e)/√e (±4, diverging). MIS:
+    /// one row per technique.
+    pub fn picture(&self, ctx: &SampleContext, sp: &ShadingPoint, size: usize) -> super::Picture {
+        use super::picture::{Picture, density_colour, residual_colour};
+        if !self.parts.is_empty() {
+            let rows: Vec<Picture> = self.parts.iter().map(|p| p.picture(ctx, sp, size)).collect();
+            return Picture::stack(&rows, 8);
+        }
+        let Some(strategy) = self.strategy else { return Picture::blank(size, size) };
+        let frame = Frame::from_z(sp.n);
+        let top = self.cells.iter().map(|c| c.0.max(c.1)).fold(1.0, f64::max).log10() as f32;
+        let cells: Vec<Option<usize>> = (0..size * size)
+            .map(|i| {
+                let d = glam::Vec2::new(((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0);
+                if d.length_squared() > 1.0 {
+                    return None;
+                }
+                cell_of(ctx, sp, strategy, frame.to_world(crate::math::disk_to_hemisphere(d)))
+            })
+            .collect();
+        let gap = 8;
+        let mut pic = Picture::blank(3 * size + 2 * gap, size);
+        for (panel, x0) in [0, size + gap, 2 * (size + gap)].into_iter().enumerate() {
+            for (i, cell) in cells.iter().enumerate() {
+                let d = glam::Vec2::new(((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0);
+                if d.length_squared() > 1.0 {
+                    continue;
+                }
+                let (o, e) = cell.and_then(|c| self.cells.get(c)).copied().unwrap_or((0.0, 0.0));
+                let colour = match panel {
+                    0 => density_colour(o as f32, top),
+                    1 => density_colour(e as f32, top),
+                    _ => residual_colour(if e > 0.0 { ((o - e) / e.sqrt()) as f32 } else if o > 0.0 { 4.0 } else { 0.0 }),
+                };
+                pic.put(x0 + i % size, i / size, colour);
+            }
+        }
+        pic
+    }
 }
 
 fn cells_per_triangle() -> usize {

@@ -19,6 +19,7 @@ pub use point::ProbePoint;
 pub use quadrature::{Quadrature, RELATIVE_TOLERANCE, quadrature};
 
 use crate::math::luminance;
+use crate::render::strategy::StrategyState;
 use crate::render::{RenderSettings, SampleContext, Strategy};
 use crate::scene::{EmitterSampler, Scene};
 use serde::Serialize;
@@ -52,6 +53,7 @@ pub struct Probe {
     scene: Arc<Scene>,
     settings: RenderSettings,
     emitters: Option<EmitterSampler>,
+    state: Option<StrategyState>,
 }
 
 /// Everything a probe found at one point for one strategy.
@@ -79,7 +81,8 @@ pub struct StrategyRow {
 impl Probe {
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
         let emitters = EmitterSampler::new(&scene, settings.light_selection);
-        Self { scene, settings, emitters }
+        let state = settings.strategy.prepare(&scene, &settings);
+        Self { scene, settings, emitters, state }
     }
 
     pub fn scene(&self) -> &Arc<Scene> {
@@ -87,7 +90,8 @@ impl Probe {
     }
 
     pub fn context(&self) -> SampleContext<'_> {
-        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis }
+        let state = self.state.as_deref();
+        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis, state }
     }
 
     /// The point under pixel (x, y) of the scene's camera.
@@ -118,17 +122,17 @@ impl Probe {
         ProbeReport { point: *point, strategy, run, quadrature, chi2, maps }
     }
 
-    /// The picture of a report.
+    /// The picture of a report; below it, if the report has one, the chi-square test's (observed, expected and
+    /// residual per cell).
     pub fn picture(&self, report: &ProbeReport, layers: Layers) -> Picture {
+        let ctx = self.context();
         let sp = report.point.shading_point(&self.scene);
-        picture::draw(
-            &self.context(),
-            &sp,
-            &report.maps,
-            &report.run.records,
-            luminance(report.quadrature.value),
-            layers,
-        )
+        let truth = luminance(report.quadrature.value);
+        let main = picture::draw(&ctx, &sp, &report.maps, &report.run.records, truth, layers);
+        match &report.chi2 {
+            Some(c) => Picture::stack(&[main, c.picture(&ctx, &sp, report.maps.size)], 12),
+            None => main,
+        }
     }
 
     /// Every registered strategy at the point, `samples` each: the lecture's "which is best here, and by how

@@ -101,6 +101,31 @@ pub struct Picture {
 }
 
 impl Picture {
+    /// An image of the background colour.
+    pub fn blank(width: usize, height: usize) -> Self {
+        Self::new(width, height)
+    }
+
+    /// Pictures one above the other, `gap` pixels apart.
+    pub fn stack(rows: &[Picture], gap: usize) -> Self {
+        let width = rows.iter().map(|r| r.width).max().unwrap_or(1);
+        let height = rows.iter().map(|r| r.height).sum::<usize>() + gap * rows.len().saturating_sub(1);
+        let mut out = Self::new(width, height.max(1));
+        let mut y0 = 0;
+        for r in rows {
+            for y in 0..r.height {
+                let (from, to) = (y * r.width * 4, ((y0 + y) * width) * 4);
+                out.rgba[to..to + r.width * 4].copy_from_slice(&r.rgba[from..from + r.width * 4]);
+            }
+            y0 += r.height + gap;
+        }
+        out
+    }
+
+    pub(super) fn put(&mut self, x: usize, y: usize, c: [u8; 4]) {
+        self.blend(x as i32, y as i32, c);
+    }
+
     fn new(width: usize, height: usize) -> Self {
         let mut rgba = vec![0; width * height * 4];
         rgba.chunks_mut(4).for_each(|p| p.copy_from_slice(&BACKGROUND));
@@ -152,7 +177,7 @@ const OUTSIDE: [u8; 4] = [40, 40, 46, 255];
 const ZERO: [u8; 4] = [8, 8, 10, 255];
 
 /// Colour of a density value on the shared log scale whose top is `top` (log10).
-fn density_colour(v: f32, top: f32) -> [u8; 4] {
+pub(super) fn density_colour(v: f32, top: f32) -> [u8; 4] {
     if !(v > 0.0) {
         return ZERO;
     }
@@ -172,6 +197,12 @@ fn ratio_colour(integrand: f32, density: f32) -> [u8; 4] {
             [c.r, c.g, c.b, 255]
         }
     }
+}
+
+/// Colour of a chi-square residual (o − e)/√e over ±4 (white at 0, red where too many samples fell).
+pub(super) fn residual_colour(r: f32) -> [u8; 4] {
+    let c = colorous::RED_BLUE.eval_continuous(((4.0 - r) / 8.0).clamp(0.0, 1.0) as f64);
+    [c.r, c.g, c.b, 255]
 }
 
 /// Colour of a sample's weight `f L cos / p`, relative to L_o, over ±3 decades.
@@ -266,10 +297,12 @@ pub fn draw(
                     Outcome::Contributed => weight_colour(1.0),
                     _ => [150, 150, 150, 160],
                 };
+                // MIS: each technique its own marker, its size growing with the MIS weight.
+                let radius = if r.mis_weight < 1.0 { 1.2 + 2.0 * r.mis_weight } else { 1.6 };
                 if r.technique == 0 {
-                    pic.disc(at, 1.6, colour);
+                    pic.disc(at, radius, colour);
                 } else {
-                    pic.ring(at, 2.5, colour);
+                    pic.ring(at, radius + 1.0, colour);
                 }
             }
         }

@@ -11,6 +11,8 @@ use wide::{CmpGt, f32x8};
 
 /// Estimates the reflected radiance at `sp` with one sample of the settings' strategy. Returns the contribution
 /// (possibly non-finite for pathological input: callers drop and count such samples) and adds the rays traced.
+/// A strategy with state of its own prepares it here on every call: to take many samples, use a
+/// [`super::Renderer`]'s [`super::Renderer::context`].
 #[inline]
 pub fn estimate_direct(
     scene: &Scene,
@@ -20,7 +22,8 @@ pub fn estimate_direct(
     rng: &mut SampleRng,
     rays: &mut u64,
 ) -> Vec3 {
-    let ctx = SampleContext { scene, emitters, mis: &settings.mis };
+    let state = settings.strategy.prepare(scene, settings);
+    let ctx = SampleContext { scene, emitters, mis: &settings.mis, state: state.as_deref() };
     settings.strategy.estimate(&ctx, sp, rng, rays, &mut ())
 }
 

@@ -3,7 +3,7 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
-use super::strategy::{MisSettings, SampleContext};
+use super::strategy::{MisSettings, SampleContext, StrategyState};
 use super::{Film, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
@@ -73,6 +73,8 @@ pub struct Renderer {
     camera: CameraBasis,
     size: (u32, u32),
     cones: Arc<PixelCones>,
+    /// The strategy's own state ([`super::strategy::DirectionStrategy::prepare`]).
+    state: Option<StrategyState>,
 }
 
 impl Renderer {
@@ -85,6 +87,7 @@ impl Renderer {
     pub fn with_camera(scene: Arc<Scene>, settings: RenderSettings, camera: &Camera) -> Self {
         Self {
             emitters: EmitterSampler::new(&scene, settings.light_selection),
+            state: settings.strategy.prepare(&scene, &settings),
             scene,
             settings,
             camera: camera.basis(),
@@ -103,7 +106,12 @@ impl Renderer {
 
     /// What its strategies read besides the shading point.
     pub fn context(&self) -> SampleContext<'_> {
-        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis }
+        SampleContext {
+            scene: &self.scene,
+            emitters: self.emitters.as_ref(),
+            mis: &self.settings.mis,
+            state: self.state.as_deref(),
+        }
     }
 
     /// The pixel cones this renderer found and keeps, to give to a later renderer of the same scene geometry

@@ -10,12 +10,15 @@
 //! MIS is the mixture its directions come from: technique i with probability n_i / (n_0 + n_1), so
 //! `p(ω) = (n_0 p_0(ω) + n_1 p_1(ω)) / (n_0 + n_1)`.
 
-use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy};
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy, StrategyState};
+use crate::render::RenderSettings;
+use crate::scene::Scene;
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::render::estimator::integrand;
 use crate::render::sink::{Outcome, SampleRecord, SampleSink};
 use glam::Vec3;
+use std::sync::Arc;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Heuristic {
@@ -89,12 +92,18 @@ impl DirectionStrategy for Mis {
     const PDF: &'static str = "w_i = (n_i p_i)^β / Σ_j (n_j p_j)^β,  β = 1 balance, 2 power";
     const DOMAIN: Domain = Domain::Mixture;
 
+    /// The states of its two techniques, if either has one.
+    fn prepare(&self, scene: &Scene, settings: &RenderSettings) -> Option<StrategyState> {
+        let states = settings.mis.techniques.map(|t| t.prepare(scene, settings));
+        states.iter().any(Option::is_some).then(|| Arc::new(TechniqueStates(states)) as StrategyState)
+    }
+
     /// A direction of the mixture: technique 0 with probability n_0 / (n_0 + n_1), reusing the choosing uniform.
     fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
         let [t0, t1] = valid_techniques(ctx)?;
         let [n0, n1] = ctx.mis.samples;
-        let chosen = if rng.uniform() * ((n0 + n1) as f32) < n0 as f32 { t0 } else { t1 };
-        let s = chosen.sample(ctx, sp, rng)?;
+        let i = if rng.uniform() * ((n0 + n1) as f32) < n0 as f32 { 0 } else { 1 };
+        let s = [t0, t1][i].sample(&technique_context(ctx, i), sp, rng)?;
         let via = match s.target {
             super::Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
             super::Target::Trace => crate::render::estimator::reached(ctx.scene, sp, s.wi),
@@ -106,7 +115,8 @@ impl DirectionStrategy for Mis {
     fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
         let Some([t0, t1]) = valid_techniques(ctx) else { return 0.0 };
         let [n0, n1] = ctx.mis.samples.map(|n| n as f32);
-        (n0 * t0.pdf(ctx, sp, wi, via) + n1 * t1.pdf(ctx, sp, wi, via)) / (n0 + n1)
+        let (c0, c1) = (technique_context(ctx, 0), technique_context(ctx, 1));
+        (n0 * t0.pdf(&c0, sp, wi, via) + n1 * t1.pdf(&c1, sp, wi, via)) / (n0 + n1)
     }
 
     /// Veach's multi-sample estimator.
@@ -122,16 +132,17 @@ impl DirectionStrategy for Mis {
         let Some(techniques) = valid_techniques(ctx) else { return Vec3::ZERO };
         let (heuristic, n) = (ctx.mis.heuristic, ctx.mis.samples);
         let mut total = Vec3::ZERO;
+        let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
         for i in 0..2 {
             let (own, other) = (techniques[i], techniques[1 - i]);
             for _ in 0..n[i] {
-                let Some(s) = own.sample(ctx, sp, rng) else {
+                let Some(s) = own.sample(&contexts[i], sp, rng) else {
                     sink.record(SampleRecord::none(i as u8));
                     continue;
                 };
                 let (contribution, w, outcome) = match integrand(ctx.scene, sp, &s, rays) {
                     Ok((value, via)) => {
-                        let p_other = other.pdf(ctx, sp, s.wi, Some(via));
+                        let p_other = other.pdf(&contexts[1 - i], sp, s.wi, Some(via));
                         let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
                         (value * (w / (n[i] as f32 * s.pdf)), w, Outcome::Contributed)
                     }
@@ -146,6 +157,16 @@ impl DirectionStrategy for Mis {
     }
 }
 
+/// MIS's state: each technique's own.
+struct TechniqueStates([Option<StrategyState>; 2]);
+
+/// The context technique i sees: MIS's, with the technique's own state.
+#[inline(always)]
+fn technique_context<'a>(ctx: &SampleContext<'a>, i: usize) -> SampleContext<'a> {
+    let state = ctx.state::<TechniqueStates>().and_then(|s| s.0[i].as_deref());
+    SampleContext { state, ..*ctx }
+}
+
 fn valid_techniques(ctx: &SampleContext) -> Option<[Strategy; 2]> {
     ctx.mis.is_valid().then_some(ctx.mis.techniques)
 }
@@ -153,6 +174,19 @@ fn valid_techniques(ctx: &SampleContext) -> Option<[Strategy; 2]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Each technique of MIS sees its own state, and a technique without one sees none.
+    #[test]
+    fn techniques_see_their_own_state() {
+        let scene = crate::scene::load_scene("cornell-box").expect("bundled");
+        let states = TechniqueStates([Some(Arc::new(7u32) as StrategyState), None]);
+        let mis = MisSettings::default();
+        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: Some(&states) };
+        assert_eq!(technique_context(&ctx, 0).state::<u32>(), Some(&7));
+        assert!(technique_context(&ctx, 1).state.is_none());
+        // No registered technique has state yet, so MIS prepares none.
+        assert!(Mis.prepare(&scene, &RenderSettings::default()).is_none());
+    }
 
     #[test]
     fn weights_sum_to_one_and_are_finite() {

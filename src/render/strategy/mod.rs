@@ -18,20 +18,36 @@ mod uniform;
 
 pub use mis::{Heuristic, MisSettings};
 
-use super::ShadingPoint;
 use super::sink::SampleSink;
+use super::{RenderSettings, ShadingPoint};
 use crate::math::SampleRng;
 use crate::scene::{EmitterSampler, Scene};
 use glam::Vec3;
+use std::any::Any;
+use std::sync::Arc;
 
-/// What a strategy may read besides the shading point: the scene and the state built once per scene and
-/// settings by the renderer that owns it (the light selection's p_Δ tables, MIS's techniques).
+/// What a strategy builds once per scene and settings (a table, a fitted lobe, a learned guide): made by
+/// [`DirectionStrategy::prepare`], owned by the renderer (which persists across passes), read by every sample
+/// through [`SampleContext::state`].
+pub type StrategyState = Arc<dyn Any + Send + Sync>;
+
+/// What a strategy may read besides the shading point: the scene and what is built once per scene and settings
+/// by the renderer that owns it (the light selection's p_Δ tables, the strategy's own state).
 #[derive(Clone, Copy)]
 pub struct SampleContext<'a> {
     pub scene: &'a Scene,
     /// p_Δ; `None` in a scene without emitters.
     pub emitters: Option<&'a EmitterSampler>,
     pub mis: &'a MisSettings,
+    /// The strategy's own state, if its `prepare` made one.
+    pub state: Option<&'a (dyn Any + Send + Sync)>,
+}
+
+impl<'a> SampleContext<'a> {
+    /// The strategy's state as its own type.
+    pub fn state<T: 'static>(&self) -> Option<&'a T> {
+        self.state?.downcast_ref()
+    }
 }
 
 /// A sampled incident direction and how to find the radiance arriving along it.
@@ -84,6 +100,11 @@ pub trait DirectionStrategy {
     const PDF: &'static str;
     const DOMAIN: Domain;
 
+    /// Builds the state the strategy keeps per scene and settings; none by default.
+    fn prepare(&self, _scene: &Scene, _settings: &RenderSettings) -> Option<StrategyState> {
+        None
+    }
+
     /// Draws ω_k. `None`: no sample could be taken (it counts as zero).
     fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample>;
 
@@ -134,6 +155,11 @@ macro_rules! registry {
 
             pub fn domain(self) -> Domain {
                 match self { $(Strategy::$variant => <$ty as DirectionStrategy>::DOMAIN),* }
+            }
+
+            /// [`DirectionStrategy::prepare`].
+            pub fn prepare(self, scene: &Scene, settings: &RenderSettings) -> Option<StrategyState> {
+                match self { $(Strategy::$variant => $ty.prepare(scene, settings)),* }
             }
 
             /// [`DirectionStrategy::sample`].
