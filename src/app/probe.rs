@@ -72,7 +72,11 @@ impl Viewer {
                 })
                 .collect();
             if self.trace {
-                let kind = if self.probe.view.as_ref().and_then(|v| v.point) == view.point { "same point" } else { "new point" };
+                let kind = if self.probe.view.as_ref().and_then(|v| v.point) == view.point {
+                    "same point"
+                } else {
+                    "new point"
+                };
                 eprintln!("trace: probe answered in {:.1} ms ({kind})", view.elapsed.as_secs_f64() * 1e3);
             }
             self.probe.view = Some(view);

@@ -120,7 +120,17 @@ pub fn chi_square_against(
         0.0
     };
     let cells = observed.into_iter().zip(cells.iter().map(|e| e * samples as f64)).collect();
-    ChiSquare { samples, statistic, dof, p_value, integral, binning, cells, strategy: Some(strategy), parts: Vec::new() }
+    ChiSquare {
+        samples,
+        statistic,
+        dof,
+        p_value,
+        integral,
+        binning,
+        cells,
+        strategy: Some(strategy),
+        parts: Vec::new(),
+    }
 }
 
 /// The cell a direction falls in, for a test binned as `strategy`'s are: a sphere cell, or the cell of the first
@@ -158,7 +168,10 @@ impl ChiSquare {
         let top = self.cells.iter().map(|c| c.0.max(c.1)).fold(1.0, f64::max).log10() as f32;
         let cells: Vec<Option<usize>> = (0..size * size)
             .map(|i| {
-                let d = glam::Vec2::new(((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0);
+                let d = glam::Vec2::new(
+                    ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                    1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
+                );
                 if d.length_squared() > 1.0 {
                     return None;
                 }
@@ -169,7 +182,10 @@ impl ChiSquare {
         let mut pic = Picture::blank(3 * size + 2 * gap, size);
         for (panel, x0) in [0, size + gap, 2 * (size + gap)].into_iter().enumerate() {
             for (i, cell) in cells.iter().enumerate() {
-                let d = glam::Vec2::new(((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0, 1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0);
+                let d = glam::Vec2::new(
+                    ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                    1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
+                );
                 if d.length_squared() > 1.0 {
                     continue;
                 }
@@ -177,7 +193,13 @@ impl ChiSquare {
                 let colour = match panel {
                     0 => density_colour(o as f32, top),
                     1 => density_colour(e as f32, top),
-                    _ => residual_colour(if e > 0.0 { ((o - e) / e.sqrt()) as f32 } else if o > 0.0 { 4.0 } else { 0.0 }),
+                    _ => residual_colour(if e > 0.0 {
+                        ((o - e) / e.sqrt()) as f32
+                    } else if o > 0.0 {
+                        4.0
+                    } else {
+                        0.0
+                    }),
                 };
                 pic.put(x0 + i % size, i / size, colour);
             }

@@ -11,12 +11,12 @@
 //! `p(ω) = (n_0 p_0(ω) + n_1 p_1(ω)) / (n_0 + n_1)`.
 
 use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy, StrategyState};
-use crate::render::RenderSettings;
-use crate::scene::Scene;
 use crate::math::SampleRng;
+use crate::render::RenderSettings;
 use crate::render::ShadingPoint;
 use crate::render::estimator::integrand;
 use crate::render::sink::{Outcome, SampleRecord, SampleSink};
+use crate::scene::Scene;
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -108,7 +108,7 @@ impl DirectionStrategy for Mis {
             super::Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
             super::Target::Trace => crate::render::estimator::reached(ctx.scene, sp, s.wi),
         };
-        let pdf = self.pdf(ctx, sp, s.wi, via);
+        let pdf = DirectionStrategy::pdf(self, ctx, sp, s.wi, via);
         (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { pdf, ..s })
     }
 
@@ -130,31 +130,104 @@ impl DirectionStrategy for Mis {
         sink: &mut S,
     ) -> Vec3 {
         let Some(techniques) = valid_techniques(ctx) else { return Vec3::ZERO };
-        let (heuristic, n) = (ctx.mis.heuristic, ctx.mis.samples);
-        let mut total = Vec3::ZERO;
-        let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
-        for i in 0..2 {
-            let (own, other) = (techniques[i], techniques[1 - i]);
-            for _ in 0..n[i] {
-                let Some(s) = own.sample(&contexts[i], sp, rng) else {
-                    sink.record(SampleRecord::none(i as u8));
-                    continue;
-                };
-                let (contribution, w, outcome) = match integrand(ctx.scene, sp, &s, rays) {
-                    Ok((value, via)) => {
-                        let p_other = other.pdf(&contexts[1 - i], sp, s.wi, Some(via));
-                        let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
-                        (value * (w / (n[i] as f32 * s.pdf)), w, Outcome::Contributed)
-                    }
-                    Err(outcome) => (Vec3::ZERO, 0.0, outcome),
-                };
-                total += contribution;
-                let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
-                sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, outcome });
+        // The usual pairs get an estimator of their own (the two techniques' code inlined), the rest the same
+        // code through the registry's dispatch: the same values either way.
+        use super::{
+            brdf::Brdf, emitter::Emitter, projected_solid_angle::ProjectedSolidAngle, solid_angle::SolidAngle,
+        };
+        match techniques {
+            [Strategy::Emitter, Strategy::Brdf] => combine(&Emitter, &Brdf, ctx, sp, rng, rays, sink),
+            [Strategy::SolidAngle, Strategy::Brdf] => combine(&SolidAngle, &Brdf, ctx, sp, rng, rays, sink),
+            [Strategy::ProjectedSolidAngle, Strategy::Brdf] => {
+                combine(&ProjectedSolidAngle, &Brdf, ctx, sp, rng, rays, sink)
             }
+            [a, b] => combine(&a, &b, ctx, sp, rng, rays, sink),
         }
-        total
     }
+}
+
+/// What MIS needs of a technique: its samples and its density (a strategy of the registry, or one known at
+/// compile time).
+trait Technique {
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample>;
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32;
+}
+
+impl<T: DirectionStrategy> Technique for T {
+    #[inline(always)]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        DirectionStrategy::sample(self, ctx, sp, rng)
+    }
+
+    #[inline(always)]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        DirectionStrategy::pdf(self, ctx, sp, wi, via)
+    }
+}
+
+impl Technique for Strategy {
+    #[inline(always)]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        Strategy::sample(*self, ctx, sp, rng)
+    }
+
+    #[inline(always)]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        Strategy::pdf(*self, ctx, sp, wi, via)
+    }
+}
+
+/// Veach's multi-sample estimator of techniques a (n_0 directions) and b (n_1), in that order.
+#[inline(always)]
+fn combine<S: SampleSink>(
+    a: &impl Technique,
+    b: &impl Technique,
+    ctx: &SampleContext,
+    sp: &ShadingPoint,
+    rng: &mut SampleRng,
+    rays: &mut u64,
+    sink: &mut S,
+) -> Vec3 {
+    let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
+    let total = directions(0, a, b, &contexts, sp, rng, rays, sink, Vec3::ZERO);
+    directions(1, b, a, &contexts, sp, rng, rays, sink, total)
+}
+
+/// Adds to `total` the n_i directions of technique i (`own`; the other is `other`), each weighted against the
+/// other's density, one after the other.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn directions<S: SampleSink>(
+    i: usize,
+    own: &impl Technique,
+    other: &impl Technique,
+    contexts: &[SampleContext; 2],
+    sp: &ShadingPoint,
+    rng: &mut SampleRng,
+    rays: &mut u64,
+    sink: &mut S,
+    mut total: Vec3,
+) -> Vec3 {
+    let ctx = &contexts[i];
+    let (heuristic, n) = (ctx.mis.heuristic, ctx.mis.samples);
+    for _ in 0..n[i] {
+        let Some(s) = own.sample(ctx, sp, rng) else {
+            sink.record(SampleRecord::none(i as u8));
+            continue;
+        };
+        let (contribution, w, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+            Ok((value, via)) => {
+                let p_other = other.pdf(&contexts[1 - i], sp, s.wi, Some(via));
+                let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
+                (value * (w / (n[i] as f32 * s.pdf)), w, Outcome::Contributed)
+            }
+            Err(outcome) => (Vec3::ZERO, 0.0, outcome),
+        };
+        total += contribution;
+        let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
+        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, outcome });
+    }
+    total
 }
 
 /// MIS's state: each technique's own.
