@@ -49,12 +49,8 @@ fn quadrature_matches_lambert_at_unoccluded_diffuse_points() {
 fn probed_points(probe: &Probe) -> Vec<(&'static str, ProbePoint)> {
     let scene = probe.scene();
     let ctx = probe.context();
-    let (mut lit, mut penumbra, mut grazing, mut glossy): (
-        Option<ProbePoint>,
-        Option<ProbePoint>,
-        Option<ProbePoint>,
-        Option<(f64, ProbePoint)>,
-    ) = (None, None, None, None);
+    let (mut lit, mut penumbra, mut grazing) = (None, None, None);
+    let mut glossy: Option<(f64, ProbePoint)> = None;
     for y in (0..scene.camera.height).step_by(2) {
         for x in (0..scene.camera.width).step_by(2) {
             let Some(point) = probe.point((x, y)) else { continue };

@@ -167,7 +167,7 @@ fn pointer(v: &mut Viewer, ui: &egui::Ui, response: &egui::Response, rect: egui:
     // The probe: a click in probe mode, Ctrl-click, or hovering with I held.
     let pixel_at = |pos: egui::Pos2| {
         let local = (pos - rect.min) / scale;
-        (local.x >= 0.0 && local.y >= 0.0).then(|| (local.x as u32, local.y as u32))
+        (local.x >= 0.0 && local.y >= 0.0).then_some((local.x as u32, local.y as u32))
     };
     let probing_click = response.clicked() && (v.probe.mode || ui.input(|i| i.modifiers.command));
     let probing_hover =

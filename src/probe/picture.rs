@@ -138,8 +138,8 @@ impl Picture {
         }
         let i = (y as usize * self.width + x as usize) * 4;
         let a = c[3] as u32;
-        for k in 0..3 {
-            self.rgba[i + k] = ((c[k] as u32 * a + self.rgba[i + k] as u32 * (255 - a)) / 255) as u8;
+        for (dst, &src) in self.rgba[i..i + 3].iter_mut().zip(&c[..3]) {
+            *dst = ((src as u32 * a + *dst as u32 * (255 - a)) / 255) as u8;
         }
         self.rgba[i + 3] = 255;
     }

@@ -1,6 +1,6 @@
 //! The sampling strategies. Each is one file implementing one contract, [`DirectionStrategy`]: it draws a
 //! direction ω_k and knows its density p(ω) for any ω, so that `f_r L_i (ω_k·n) / p(ω_k)` estimates the
-//! scattering integral; all of them estimate the same integral. The [`registry!`] below lists them, and
+//! scattering integral; all of them estimate the same integral. The `registry!` below lists them, and
 //! everything that lists strategies (the CLI, the viewer, `illumlab strategies`, the tests) iterates
 //! [`Strategy::ALL`].
 //!
