@@ -53,3 +53,4 @@ shoot_probe() { # name seconds scene args…
 shoot_probe cornell-box-mis 10 cornell-box --strategy mis --exposure 1 --probe 60,225
 shoot_probe veach-mis-mis 10 veach-mis --strategy mis --probe 90,200
 shoot_probe veach-mis-emitter 10 veach-mis --strategy emitter --probe 90,200
+shoot_probe compare-default 12 default --strategy mis --compare brdf --probe 150,260

@@ -151,3 +151,53 @@ fn scene_without_triangles_renders_black() {
     renderer.render_pass(&mut film, 0, 2, &|| false);
     assert!(film.means().iter().all(|c| *c == Vec3::ZERO));
 }
+
+/// The probe at the same extreme points, for every strategy and every α, black materials included: its
+/// quadrature, running estimate, maps and chi-square test give finite numbers and do not panic.
+#[test]
+fn the_probe_is_finite_at_the_extremes() {
+    use illumlab::probe::{Maps, ProbeRun, chi_square, quadrature};
+    use illumlab::render::SampleContext;
+    use illumlab::scene::EmitterSampler;
+    let scene = scene(any_camera());
+    let emitters = EmitterSampler::new(&scene, LightSelection::Power);
+    let mis = MisSettings::default();
+    let ctx = SampleContext { scene: &scene, emitters: emitters.as_ref(), mis: &mis, state: None };
+    let view = Vec3::new(0.2, 0.9, 0.1).normalize();
+    let points = [
+        (Vec3::new(0.1, 0.0, 0.0), Vec3::Y, Vec3::new(1.0, 1e-6, 0.3).normalize()),
+        (Vec3::new(0.2, 1.0 - 1e-4, 0.1), Vec3::Y, view),
+        (Vec3::new(0.0, 1.0, 0.0), -Vec3::Y, -view),
+        (Vec3::new(1e4, 0.0, 0.0), Vec3::Y, Vec3::new(-1.0, 1e-5, 0.0).normalize()),
+        (Vec3::new(2.0, 0.0, 0.0), Vec3::Y, view),
+        (Vec3::new(-3.0 + 1e-4, 0.0, 0.0), Vec3::Y, view),
+    ];
+    let materials: Vec<Material> = materials().into_iter().filter(|m| m.kd == m.ks || m.kd.x == 0.0).collect();
+    for (p, n, wo) in points {
+        for m in &materials {
+            let sp = ShadingPoint::new(p, n, wo, m);
+            let q = quadrature(&scene, &sp, 20_000);
+            assert!(
+                q.value.is_finite() && q.value.min_element() >= 0.0,
+                "{p}, α = {}: quadrature {}",
+                m.alpha,
+                q.value
+            );
+            let truth = illumlab::math::luminance(q.value);
+            for strategy in Strategy::ALL {
+                let what = format!("{p}, α = {}, k_d {}, {}", m.alpha, m.kd.x, strategy.name());
+                let run = ProbeRun::run(&ctx, &sp, strategy, 64, 1, 64, truth);
+                assert_eq!(run.non_finite, 0, "{what}");
+                assert!(run.mean().is_finite() && run.std_error().is_finite(), "{what}");
+                assert!(!run.relative_variance(truth as f64).is_nan() && !run.z_score(truth as f64).is_nan(), "{what}");
+                let maps = Maps::new(&ctx, &sp, strategy, truth, 12);
+                assert!(
+                    maps.density.iter().chain(&maps.integrand).all(|v| v.is_nan() || (v.is_finite() && *v >= 0.0)),
+                    "{what}"
+                );
+                let c = chi_square(&ctx, &sp, strategy, 300, 2);
+                assert!((0.0..=1.0).contains(&c.p_value) && c.integral.is_finite(), "{what}: {c:?}");
+            }
+        }
+    }
+}

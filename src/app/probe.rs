@@ -203,20 +203,21 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         if waiting { "  (updating…)" } else { "" }
     ));
     ui.small(format!("{PROJECTION}. Computed in {:.0} ms.", view.elapsed.as_secs_f64() * 1e3));
-    let lanes = view.lanes.len();
-    for (i, ((report, picture), texture)) in view.lanes.iter().zip(&v.probe.textures).enumerate() {
-        ui.separator();
-        let lane = if lanes > 1 { ["A: ", "B: "][i] } else { "" };
-        // egui's fonts have no ‖: the norm is written |…|.
-        ui.strong(format!("{lane}{} — {}", report.strategy.name(), report.strategy.pdf_formula().replace('‖', "|")));
-        let width = ui.available_width().min(picture.width as f32 * 1.2);
-        let size = egui::vec2(width, width * picture.height as f32 / picture.width as f32);
-        ui.image((texture.id(), size));
-        ui.small("left: integrand / L_o · middle: density p(ω) (same log scale) · right: their ratio (white = ideal, red = too rare: fireflies) · dots: last samples by weight f L cos/p relative to L_o (blue low, red high; grey = zero; rings = MIS's 2nd technique; MIS dots grow with their weight)");
-        if report.chi2.is_some() {
-            ui.small("chi-square rows: draws observed per cell · counts the pdf expects (same log scale) · residual (o − e)/√e from −4 (blue) to +4 (red); MIS: one row per technique");
-        }
-        numbers_ui(ui, report);
+    ui.small("left: integrand / L_o · middle: density p(ω) (same log scale) · right: their ratio (white = ideal, red = too rare: fireflies) · dots: last samples by weight f L cos/p relative to L_o (blue low, red high; grey = zero; rings = MIS's 2nd technique; MIS dots grow with their weight)");
+    if view.lanes.iter().any(|(r, _)| r.chi2.is_some()) {
+        ui.small("chi-square rows: draws observed per cell · counts the pdf expects (same log scale) · residual (o − e)/√e from −4 (blue) to +4 (red); MIS: one row per technique");
+    }
+    ui.separator();
+    let lanes: Vec<_> = view.lanes.iter().zip(&v.probe.textures).collect();
+    if let [a, b] = lanes[..] {
+        // Compare mode: A and B side by side, at the same point with the same random streams.
+        ui.columns(2, |columns| {
+            for (ui, (label, ((report, picture), texture))) in columns.iter_mut().zip([("A: ", a), ("B: ", b)]) {
+                lane_ui(ui, label, report, picture, texture);
+            }
+        });
+    } else if let Some(((report, picture), texture)) = lanes.first() {
+        lane_ui(ui, "", report, picture, texture);
     }
     if let Some(rows) = &view.table {
         ui.separator();
@@ -236,6 +237,22 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
             }
         });
     }
+}
+
+/// One lane's picture and numbers.
+fn lane_ui(
+    ui: &mut egui::Ui,
+    label: &str,
+    report: &crate::probe::ProbeReport,
+    picture: &crate::probe::Picture,
+    texture: &egui::TextureHandle,
+) {
+    // egui's fonts have no ‖: the norm is written |…|.
+    ui.strong(format!("{label}{} — {}", report.strategy.name(), report.strategy.pdf_formula().replace('‖', "|")));
+    let width = ui.available_width().min(picture.width as f32 * 1.2);
+    let size = egui::vec2(width, width * picture.height as f32 / picture.width as f32);
+    ui.image((texture.id(), size));
+    numbers_ui(ui, report);
 }
 
 fn numbers_ui(ui: &mut egui::Ui, r: &crate::probe::ProbeReport) {
