@@ -114,11 +114,7 @@ pub fn chi_square_against(
     let integral: f64 = cells.iter().sum();
     cells.push((1.0 - integral).max(0.0));
     let (statistic, dof) = pearson(&observed, &cells, samples as f64);
-    let p_value = if statistic.is_finite() {
-        ChiSquared::new(dof.max(1) as f64).map(|d| d.sf(statistic)).unwrap_or(0.0)
-    } else {
-        0.0
-    };
+    let p_value = p_value(statistic, dof);
     let cells = observed.into_iter().zip(cells.iter().map(|e| e * samples as f64)).collect();
     ChiSquare {
         samples,
@@ -350,9 +346,18 @@ fn light_cells(
         .collect()
 }
 
-/// Pearson's statistic after pooling every cell expecting fewer than 5 samples into one, and its degrees of
-/// freedom.
-fn pearson(observed: &[f64], expected_fraction: &[f64], n: f64) -> (f64, usize) {
+/// The probability that a statistic this large or larger arises by chance: the chi-square distribution's upper
+/// tail with `dof` degrees of freedom (0 for an infinite statistic).
+pub fn p_value(statistic: f64, dof: usize) -> f64 {
+    if !statistic.is_finite() {
+        return 0.0;
+    }
+    ChiSquared::new(dof.max(1) as f64).map(|d| d.sf(statistic)).unwrap_or(0.0)
+}
+
+/// Pearson's statistic of `observed` counts against `expected_fraction` of `n` draws per cell, after pooling every
+/// cell expecting fewer than 5 samples into one, and its degrees of freedom.
+pub fn pearson(observed: &[f64], expected_fraction: &[f64], n: f64) -> (f64, usize) {
     let (mut stat, mut cells) = (0.0, 0usize);
     let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
     for (&o, &e) in observed.iter().zip(expected_fraction) {

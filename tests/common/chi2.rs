@@ -4,7 +4,7 @@
 
 use glam::{DVec2, DVec3, Vec2, Vec3};
 use illumlab::math::SampleRng;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
+use illumlab::probe::chi2::{p_value, pearson};
 
 /// Significance level of one test before the Šidák correction for the number of tests in a file: with a fresh
 /// seed, a correct sampler fails a file of k tests with probability 1%.
@@ -107,7 +107,7 @@ impl SphereBins {
                 eprintln!("cell {i}: observed {} expected {:.1} (χ² {r:.1})", observed[i], expected[i] * n as f64);
             }
         }
-        let (statistic, dof) = chi_square(&observed, &expected, n as f64);
+        let (statistic, dof) = pearson(&observed, &expected, n as f64);
         Outcome { statistic, dof, p_value: p_value(statistic, dof), integral }
     }
 }
@@ -158,7 +158,7 @@ pub fn triangle_test(
         }
     }
     let integral = expected.iter().sum();
-    let (statistic, dof) = chi_square(&observed, &expected, n as f64);
+    let (statistic, dof) = pearson(&observed, &expected, n as f64);
     Outcome { statistic, dof, p_value: p_value(statistic, dof), integral }
 }
 
@@ -172,39 +172,8 @@ pub fn discrete_test(probabilities: &[f64], samples: u64, seed: u64, sample: &dy
         assert!((p as f64 - probabilities[i]).abs() <= 1e-6 * probabilities[i], "index {i} claims p = {p}");
         observed[i] += 1.0;
     }
-    let (statistic, dof) = chi_square(&observed, probabilities, samples as f64);
+    let (statistic, dof) = pearson(&observed, probabilities, samples as f64);
     Outcome { statistic, dof, p_value: p_value(statistic, dof), integral: probabilities.iter().sum() }
-}
-
-/// Pearson's statistic after pooling every cell expecting fewer than 5 samples into one.
-fn chi_square(observed: &[f64], expected_fraction: &[f64], n: f64) -> (f64, usize) {
-    let (mut stat, mut cells) = (0.0, 0usize);
-    let (mut pooled_obs, mut pooled_exp) = (0.0, 0.0);
-    for (&o, &e) in observed.iter().zip(expected_fraction) {
-        let e = e * n;
-        if e < 5.0 {
-            pooled_obs += o;
-            pooled_exp += e;
-        } else {
-            stat += (o - e) * (o - e) / e;
-            cells += 1;
-        }
-    }
-    if pooled_exp > 0.0 {
-        stat += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
-        cells += 1;
-    } else if pooled_obs > 0.0 {
-        // Samples where the density says none can be.
-        stat = f64::INFINITY;
-    }
-    (stat, cells.saturating_sub(1))
-}
-
-fn p_value(statistic: f64, dof: usize) -> f64 {
-    if !statistic.is_finite() {
-        return 0.0;
-    }
-    ChiSquared::new(dof.max(1) as f64).map(|d| d.sf(statistic)).unwrap_or(0.0)
 }
 
 /// Composite 3-point Gauss–Legendre rule over the rectangle [lo, hi] with `sub` intervals per side. Its nodes

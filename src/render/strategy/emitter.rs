@@ -1,8 +1,7 @@
 //! Emitter (area-light) sampling: pick a triangle with p_Δ, a uniform point x on it, and aim at it:
 //! `p(ω) = p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|)`. A shadow ray decides visibility.
 
-use super::light::{TriangleSampler, area_pdf_solid_angle, light_pdf, sample_light};
-use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext};
+use super::light::{LightStrategy, TriangleSampler, area_pdf_solid_angle};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::sampling::sample_uniform_triangle;
@@ -35,19 +34,8 @@ impl TriangleSampler for Emitter {
     }
 }
 
-impl DirectionStrategy for Emitter {
+impl LightStrategy for Emitter {
     const NAME: &'static str = "emitter";
     const DESCRIPTION: &'static str = "area-light sampling: triangle with p_Δ, uniform point on it, shadow ray";
     const PDF: &'static str = "p(ω) = p_Δ ‖x−p‖² / (A_Δ |n_Δ·ω|)";
-    const DOMAIN: Domain = Domain::Lights;
-
-    #[inline(always)]
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        sample_light::<Self>(ctx, sp, rng)
-    }
-
-    #[inline]
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        light_pdf::<Self>(ctx, sp, wi, via)
-    }
 }

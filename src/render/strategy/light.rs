@@ -1,9 +1,9 @@
 //! What the light strategies share: each picks an emitter triangle Δ with p_Δ and then a direction towards it,
 //! `p(ω) = p_Δ p(ω | Δ)`, and can evaluate that density for any direction that reaches an emitter (multiple
 //! importance sampling and the probe need it). A light strategy implements [`TriangleSampler`] (the part given
-//! Δ) and its [`super::DirectionStrategy`] calls [`sample_light`] and [`light_pdf`].
+//! Δ) and [`LightStrategy`] (its names); its [`DirectionStrategy`] follows, by [`sample_light`] and [`light_pdf`].
 
-use super::{DirectionSample, Reached, SampleContext, Target};
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Target};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::scene::Triangle;
@@ -16,6 +16,30 @@ pub trait TriangleSampler {
 
     /// The density given Δ of `wi`, which meets Δ at `x`.
     fn triangle_pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32;
+}
+
+/// A light strategy's names, as [`DirectionStrategy`] has them.
+pub trait LightStrategy: TriangleSampler {
+    const NAME: &'static str;
+    const DESCRIPTION: &'static str;
+    const PDF: &'static str;
+}
+
+impl<T: LightStrategy> DirectionStrategy for T {
+    const NAME: &'static str = <T as LightStrategy>::NAME;
+    const DESCRIPTION: &'static str = <T as LightStrategy>::DESCRIPTION;
+    const PDF: &'static str = <T as LightStrategy>::PDF;
+    const DOMAIN: Domain = Domain::Lights;
+
+    #[inline(always)]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        sample_light::<T>(ctx, sp, rng)
+    }
+
+    #[inline]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        light_pdf::<T>(ctx, sp, wi, via)
+    }
 }
 
 /// Picks Δ with p_Δ, then a direction towards it: density `p_Δ p(ω | Δ)`.

@@ -4,8 +4,7 @@
 //! spherical-triangle samples; area sampling where that would be inefficient (see [`ProjectedPlan`]).
 
 use super::emitter::Emitter;
-use super::light::{TriangleSampler, area_pdf_solid_angle, hit_plane, light_pdf, sample_light};
-use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext};
+use super::light::{LightStrategy, TriangleSampler, area_pdf_solid_angle, hit_plane};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::sampling::{ProjectedPlan, projected_triangle_pdf, sample_projected_triangle};
@@ -43,20 +42,9 @@ impl TriangleSampler for ProjectedSolidAngle {
     }
 }
 
-impl DirectionStrategy for ProjectedSolidAngle {
+impl LightStrategy for ProjectedSolidAngle {
     const NAME: &'static str = "projected-solid-angle";
     const DESCRIPTION: &'static str =
         "directions proportional to cos θ over a light triangle (exact): ideal for diffuse";
     const PDF: &'static str = "p(ω) = p_Δ (ω·n) / Ω_proj,  Ω_proj = ½ Σ Θ_i (n·γ_i)";
-    const DOMAIN: Domain = Domain::Lights;
-
-    #[inline]
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        sample_light::<Self>(ctx, sp, rng)
-    }
-
-    #[inline]
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        light_pdf::<Self>(ctx, sp, wi, via)
-    }
 }

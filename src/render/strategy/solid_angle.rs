@@ -4,8 +4,7 @@
 //! area instead, with that density.
 
 use super::emitter::Emitter;
-use super::light::{TriangleSampler, area_pdf_solid_angle, hit_plane, light_pdf, sample_light};
-use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext};
+use super::light::{LightStrategy, TriangleSampler, area_pdf_solid_angle, hit_plane};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::sampling::{
@@ -42,19 +41,8 @@ impl TriangleSampler for SolidAngle {
     }
 }
 
-impl DirectionStrategy for SolidAngle {
+impl LightStrategy for SolidAngle {
     const NAME: &'static str = "solid-angle";
     const DESCRIPTION: &'static str = "uniform directions in the spherical triangle of a light triangle (Arvo 1995)";
     const PDF: &'static str = "p(ω) = p_Δ / Ω_Δ   (area sampling where Ω_Δ < 3e-4 or > 6.22 sr)";
-    const DOMAIN: Domain = Domain::Lights;
-
-    #[inline]
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        sample_light::<Self>(ctx, sp, rng)
-    }
-
-    #[inline]
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        light_pdf::<Self>(ctx, sp, wi, via)
-    }
 }
