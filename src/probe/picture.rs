@@ -13,7 +13,7 @@
 //! grey; MIS's second technique as rings).
 
 use super::density::density;
-use crate::math::{Frame, disk_to_hemisphere, hemisphere_to_disk, luminance, reflect};
+use crate::math::{Frame, SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk, luminance, reflect};
 use crate::render::strategy::light::faces;
 use crate::render::{Outcome, SampleContext, SampleRecord, ShadingPoint, Strategy, reached};
 use glam::{Vec2, Vec3};
@@ -82,7 +82,7 @@ impl Maps {
             })
             .collect();
         // ∫ p over the upper hemisphere from the grid (dω = 2 dA, a pixel's area (2/size)²); the rest is below.
-        let cell = 2.0 * (2.0 / size as f32).powi(2);
+        let cell = SOLID_ANGLE_PER_DISK_AREA * (2.0 / size as f32).powi(2);
         let above: f32 = values.iter().filter(|v| v.1.is_finite()).map(|v| v.1 * cell).sum();
         Self {
             size,

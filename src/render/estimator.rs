@@ -48,15 +48,6 @@ pub fn one_sample<S: SampleSink>(
     contribution
 }
 
-impl SampleRecord {
-    /// A strategy that could draw no direction.
-    #[inline(always)]
-    pub fn none(technique: u8) -> Self {
-        let (wi, contribution) = (Vec3::ZERO, Vec3::ZERO);
-        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, outcome: Outcome::NoSample }
-    }
-}
-
 /// `f_r L_i (ω·n)` for a sampled direction (not yet divided by the density), and the emitter triangle and point
 /// it reached; where it is zero, why.
 #[inline]

@@ -66,6 +66,15 @@ pub struct SampleRecord {
     pub outcome: Outcome,
 }
 
+impl SampleRecord {
+    /// A strategy that could draw no direction.
+    #[inline(always)]
+    pub fn none(technique: u8) -> Self {
+        let (wi, contribution) = (Vec3::ZERO, Vec3::ZERO);
+        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, outcome: Outcome::NoSample }
+    }
+}
+
 /// Receives the records of the directions an estimator evaluates.
 pub trait SampleSink {
     fn record(&mut self, record: SampleRecord);

@@ -98,7 +98,8 @@ impl DirectionStrategy for Mis {
         states.iter().any(Option::is_some).then(|| Arc::new(TechniqueStates(states)) as StrategyState)
     }
 
-    /// A direction of the mixture: technique 0 with probability n_0 / (n_0 + n_1), reusing the choosing uniform.
+    /// A direction of the mixture: technique 0 with probability n_0 / (n_0 + n_1) (one uniform chooses), and the
+    /// mixture density.
     fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
         let [t0, t1] = valid_techniques(ctx)?;
         let [n0, n1] = ctx.mis.samples;
