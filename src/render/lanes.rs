@@ -7,8 +7,8 @@
 //! bit, so a film does not depend on how its samples were grouped.
 
 use super::estimator::{unshadowed, visible_lanes};
-use super::strategy::SampleContext;
-use super::{ShadingPoint, Strategy, Target};
+use super::strategy::{SampleContext, Technique};
+use super::{ShadingPoint, Target};
 use crate::math::{SampleRng, SampleRngLanes, Vec3x8, for_each_lane};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
@@ -129,7 +129,7 @@ pub fn estimate_emitter_lanes(
 #[inline]
 pub fn estimate_light_lanes(
     ctx: &SampleContext,
-    strategy: Strategy,
+    strategy: &impl Technique,
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],

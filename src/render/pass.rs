@@ -3,7 +3,7 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
-use super::strategy::{MisSettings, SampleContext, StrategyState};
+use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
@@ -237,7 +237,15 @@ impl Renderer {
             }
             (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                estimate_light_lanes(&self.context(), strategy, &dirs, &hits, &mut rngs, rays)
+                let ctx = self.context();
+                // The bundled light strategies' own code, inlined; any other through the registry.
+                match strategy {
+                    Strategy::SolidAngle => estimate_light_lanes(&ctx, &SolidAngle, &dirs, &hits, &mut rngs, rays),
+                    Strategy::ProjectedSolidAngle => {
+                        estimate_light_lanes(&ctx, &ProjectedSolidAngle, &dirs, &hits, &mut rngs, rays)
+                    }
+                    _ => estimate_light_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
+                }
             }
             _ => std::array::from_fn(|l| {
                 hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays))

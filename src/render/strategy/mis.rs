@@ -10,7 +10,7 @@
 //! MIS is the mixture its directions come from: technique i with probability n_i / (n_0 + n_1), so
 //! `p(ω) = (n_0 p_0(ω) + n_1 p_1(ω)) / (n_0 + n_1)`.
 
-use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy, StrategyState};
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Strategy, StrategyState, Technique};
 use crate::math::SampleRng;
 use crate::render::RenderSettings;
 use crate::render::ShadingPoint;
@@ -144,37 +144,6 @@ impl DirectionStrategy for Mis {
             }
             [a, b] => combine(&a, &b, ctx, sp, rng, rays, sink),
         }
-    }
-}
-
-/// What MIS needs of a technique: its samples and its density (a strategy of the registry, or one known at
-/// compile time).
-trait Technique {
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample>;
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32;
-}
-
-impl<T: DirectionStrategy> Technique for T {
-    #[inline(always)]
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        DirectionStrategy::sample(self, ctx, sp, rng)
-    }
-
-    #[inline(always)]
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        DirectionStrategy::pdf(self, ctx, sp, wi, via)
-    }
-}
-
-impl Technique for Strategy {
-    #[inline(always)]
-    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        Strategy::sample(*self, ctx, sp, rng)
-    }
-
-    #[inline(always)]
-    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        Strategy::pdf(*self, ctx, sp, wi, via)
     }
 }
 

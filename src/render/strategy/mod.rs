@@ -17,6 +17,8 @@ mod solid_angle;
 mod uniform;
 
 pub use mis::{Heuristic, MisSettings};
+pub use projected_solid_angle::ProjectedSolidAngle;
+pub use solid_angle::SolidAngle;
 
 use super::sink::SampleSink;
 use super::{RenderSettings, ShadingPoint};
@@ -128,6 +130,38 @@ pub trait DirectionStrategy {
     }
 }
 
+/// What MIS and the eight-lane path need of a strategy: its samples and its density. Implemented by every
+/// strategy's own type (known at compile time, so its code is inlined) and by [`Strategy`] (dispatched at run
+/// time): the same values either way.
+pub trait Technique {
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample>;
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32;
+}
+
+impl<T: DirectionStrategy> Technique for T {
+    #[inline(always)]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        DirectionStrategy::sample(self, ctx, sp, rng)
+    }
+
+    #[inline(always)]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        DirectionStrategy::pdf(self, ctx, sp, wi, via)
+    }
+}
+
+impl Technique for Strategy {
+    #[inline(always)]
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        Strategy::sample(*self, ctx, sp, rng)
+    }
+
+    #[inline(always)]
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        Strategy::pdf(*self, ctx, sp, wi, via)
+    }
+}
+
 /// Generates [`Strategy`], the registry: one line per strategy, `Variant => path::Type`.
 macro_rules! registry {
     ($($variant:ident => $ty:path),* $(,)?) => {
@@ -165,13 +199,13 @@ macro_rules! registry {
             /// [`DirectionStrategy::sample`].
             #[inline(always)]
             pub fn sample(self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-                match self { $(Strategy::$variant => $ty.sample(ctx, sp, rng)),* }
+                match self { $(Strategy::$variant => DirectionStrategy::sample(&$ty, ctx, sp, rng)),* }
             }
 
             /// [`DirectionStrategy::pdf`].
             #[inline]
             pub fn pdf(self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-                match self { $(Strategy::$variant => $ty.pdf(ctx, sp, wi, via)),* }
+                match self { $(Strategy::$variant => DirectionStrategy::pdf(&$ty, ctx, sp, wi, via)),* }
             }
 
             /// [`DirectionStrategy::estimate`].
