@@ -191,7 +191,7 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     };
     let material = v.scene.material_names.get(point.material as usize).map_or("?", |s| s.as_str());
     ui.label(format!(
-        "pixel {},{}  p = ({:.3}, {:.3}, {:.3})  n = ({:.2}, {:.2}, {:.2})  material {material}{}",
+        "pixel {},{}  p = ({:.3}, {:.3}, {:.3})  n = ({:.2}, {:.2}, {:.2})  ω_o = ({:.2}, {:.2}, {:.2})  material {material}{}",
         point.pixel.0,
         point.pixel.1,
         point.position.x,
@@ -200,6 +200,9 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         point.normal.x,
         point.normal.y,
         point.normal.z,
+        point.wo.x,
+        point.wo.y,
+        point.wo.z,
         if waiting { "  (updating…)" } else { "" }
     ));
     ui.small(format!("{PROJECTION}. Computed in {:.0} ms.", view.elapsed.as_secs_f64() * 1e3));
