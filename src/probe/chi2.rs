@@ -154,7 +154,7 @@ impl ChiSquare {
     /// per cell, the counts the pdf expects (same log scale), and the residual (o − e)/√e (±4, diverging). MIS:
     /// one row per technique.
     pub fn picture(&self, ctx: &SampleContext, sp: &ShadingPoint, size: usize) -> super::Picture {
-        use super::picture::{Picture, density_colour, residual_colour};
+        use super::picture::{Picture, density_colour, disk_point, residual_colour};
         if !self.parts.is_empty() {
             let rows: Vec<Picture> = self.parts.iter().map(|p| p.picture(ctx, sp, size)).collect();
             return Picture::stack(&rows, 8);
@@ -162,29 +162,18 @@ impl ChiSquare {
         let Some(strategy) = self.strategy else { return Picture::blank(size, size) };
         let frame = Frame::from_z(sp.n);
         let top = self.cells.iter().map(|c| c.0.max(c.1)).fold(1.0, f64::max).log10() as f32;
-        let cells: Vec<Option<usize>> = (0..size * size)
+        // Per pixel on the disk, the cell its direction falls in (if any).
+        let cells: Vec<Option<Option<usize>>> = (0..size * size)
             .map(|i| {
-                let d = glam::Vec2::new(
-                    ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-                    1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
-                );
-                if d.length_squared() > 1.0 {
-                    return None;
-                }
-                cell_of(ctx, sp, strategy, frame.to_world(crate::math::disk_to_hemisphere(d)))
+                let d = disk_point(i, size)?;
+                Some(cell_of(ctx, sp, strategy, frame.to_world(crate::math::disk_to_hemisphere(d))))
             })
             .collect();
         let gap = 8;
         let mut pic = Picture::blank(3 * size + 2 * gap, size);
         for (panel, x0) in [0, size + gap, 2 * (size + gap)].into_iter().enumerate() {
             for (i, cell) in cells.iter().enumerate() {
-                let d = glam::Vec2::new(
-                    ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-                    1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
-                );
-                if d.length_squared() > 1.0 {
-                    continue;
-                }
+                let Some(cell) = cell else { continue };
                 let (o, e) = cell.and_then(|c| self.cells.get(c)).copied().unwrap_or((0.0, 0.0));
                 let colour = match panel {
                     0 => density_colour(o as f32, top),

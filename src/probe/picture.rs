@@ -58,19 +58,10 @@ impl Maps {
     /// `truth` is the point's L_o luminance (the integrand's normaliser).
     pub fn new(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, truth: f32, size: usize) -> Self {
         let frame = Frame::from_z(sp.n);
-        let px = |i: usize| {
-            Vec2::new(
-                ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-                1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
-            )
-        };
         let values: Vec<(f32, f32)> = (0..size * size)
             .into_par_iter()
             .map(|i| {
-                let d = px(i);
-                if d.length_squared() > 1.0 {
-                    return (f32::NAN, f32::NAN);
-                }
+                let Some(d) = disk_point(i, size) else { return (f32::NAN, f32::NAN) };
                 let wi = frame.to_world(disk_to_hemisphere(d));
                 let f = sp.material.eval_brdf(sp.n, sp.wo, wi);
                 let li = match reached(ctx.scene, sp, wi) {
@@ -91,6 +82,15 @@ impl Maps {
             below_horizon: (1.0 - above).clamp(0.0, 1.0),
         }
     }
+}
+
+/// The disk point at the centre of pixel i of a `size`² grid (row-major, rows from the top), if it is on the disk.
+pub(super) fn disk_point(i: usize, size: usize) -> Option<Vec2> {
+    let d = Vec2::new(
+        ((i % size) as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+        1.0 - ((i / size) as f32 + 0.5) / size as f32 * 2.0,
+    );
+    (d.length_squared() <= 1.0).then_some(d)
 }
 
 /// An RGBA image.

@@ -4,7 +4,7 @@
 //! of a point is kept while only the strategies change, and the answer comes through a latest-value slot.
 
 use crate::probe::{
-    Layers, Picture, Probe, ProbeJson, ProbePoint, ProbeReport, ProbeSettings, Quadrature, StrategyRow,
+    Layers, Picture, Probe, ProbeJson, ProbePoint, ProbeReport, ProbeSettings, Quadrature, StrategyRow, quadrature,
 };
 use crate::render::{RenderSettings, write_png_rgba};
 use crate::scene::{Camera, Scene};
@@ -132,8 +132,8 @@ fn serve(rx: Receiver<ProbeRequest>, slot: Arc<Mutex<Option<ProbeView>>>, notify
                     *q
                 }
                 _ => {
-                    let probe = Probe::new(request.scene.clone(), RenderSettings::default());
-                    let q = probe.quadrature(&point, &request.settings);
+                    let scene = &request.scene;
+                    let q = quadrature(scene, &point.shading_point(scene), request.settings.quadrature_nodes);
                     kept = Some((request.scene.clone(), point, request.settings.quadrature_nodes, q));
                     q
                 }
