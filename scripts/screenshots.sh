@@ -54,3 +54,10 @@ shoot_probe cornell-box-mis 10 cornell-box --strategy mis --exposure 1 --probe 6
 shoot_probe veach-mis-mis 10 veach-mis --strategy mis --probe 90,200
 shoot_probe veach-mis-emitter 10 veach-mis --strategy emitter --probe 90,200
 shoot_probe compare-default 12 default --strategy mis --compare brdf --probe 150,260
+# The near light over a glossy floor (α = 30), the lobe inside the light: brdf-polygon's density follows the lobe,
+# projected-solid-angle's only the cosine.
+glossy=$runtime/glossy-near-light.toml
+sed -e "s#obj = \"near-light.obj\"#obj = \"$PWD/assets/near-light/near-light.obj\"#" assets/near-light/near-light.toml >"$glossy"
+printf '[mesh.materials.floor]\nkd = [0.2, 0.2, 0.2]\nks = [0.6, 0.6, 0.6]\nalpha = 30.0\n' >>"$glossy"
+shoot_probe glossy-near-light-brdf-polygon 12 "$glossy" --strategy brdf-polygon --exposure -3 --probe 128,131
+shoot_probe glossy-near-light-projected-solid-angle 12 "$glossy" --strategy projected-solid-angle --exposure -3 --probe 128,131

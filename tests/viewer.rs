@@ -171,7 +171,7 @@ fn choosing_a_bundled_scene_loads_it_in_the_background() {
 #[test]
 fn mis_controls_reach_the_integrator() {
     let mut h = harness(viewer());
-    h.get_by_label("7 mis").click();
+    h.get_by_label("8 mis").click();
     h.step();
     h.step();
     h.get_by_role_and_label(Role::RadioButton, "balance").click();

@@ -3,6 +3,7 @@
 
 mod discrete;
 mod hemisphere;
+mod ltc;
 mod phong_lobe;
 mod projected_triangle;
 mod spherical_triangle;
@@ -12,9 +13,10 @@ pub use discrete::DiscreteDistribution;
 pub use hemisphere::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };
+pub use ltc::{PhongLtc, phong_ltc_scale_squared};
 pub use phong_lobe::{phong_lobe_pdf, phong_lobe_pdf_from_gap, sample_phong_lobe};
 pub use projected_triangle::{
-    MIN_ACCEPTANCE, ProjectedPlan, projected_solid_angle, projected_triangle_pdf, sample_projected_triangle,
+    MIN_ACCEPTANCE, ProjectedPlan, max_cosine, projected_solid_angle, projected_triangle_pdf, sample_projected_triangle,
 };
 pub use spherical_triangle::{
     MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA, sample_spherical_triangle, spherical_triangle_area,

@@ -31,7 +31,11 @@ pub enum ProjectedPlan {
 
 impl ProjectedPlan {
     pub fn new(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Self {
-        let projected = projected_solid_angle(p, n, a, b, c);
+        Self::with_projected(p, n, a, b, c, projected_solid_angle(p, n, a, b, c))
+    }
+
+    /// [`ProjectedPlan::new`] given the triangle's [`projected_solid_angle`] (computed already).
+    pub fn with_projected(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3, projected: f32) -> Self {
         if !(projected > 0.0) {
             return ProjectedPlan::Invisible;
         }
@@ -99,7 +103,7 @@ pub fn projected_solid_angle(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32
 
 /// max of ω·n over the spherical triangle of (a, b, c) seen from p: 1 where n points into it, else the largest
 /// of the vertices and of each edge's great-circle arc (whose maximum is where n projects onto its plane).
-fn max_cosine(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+pub fn max_cosine(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let n = n.as_dvec3();
     let v = [(a - p).as_dvec3().normalize(), (b - p).as_dvec3().normalize(), (c - p).as_dvec3().normalize()];
     let orientation = v[0].dot(v[1].cross(v[2])).signum();

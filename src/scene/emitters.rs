@@ -138,6 +138,15 @@ impl EmitterSampler {
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records })
     }
 
+    pub fn selection(&self) -> LightSelection {
+        self.selection
+    }
+
+    /// The scene's emitter triangles, in the selection's order.
+    pub fn triangles(&self) -> &[u32] {
+        &self.triangles
+    }
+
     /// What [`EmitterSampler::pick`] picks for eight uniforms (record i for `u[i]`), as light sampling reads it,
     /// for the selections that do not depend on the shading point (`None` for [`LightSelection::Contribution`]).
     #[inline(always)]

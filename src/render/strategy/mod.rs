@@ -8,6 +8,7 @@
 //! registry, and its tests (the chi-square, unbiasedness and pass tests iterate the registry by themselves).
 
 mod brdf;
+mod brdf_polygon;
 mod cosine;
 mod emitter;
 pub mod light;
@@ -16,6 +17,7 @@ mod projected_solid_angle;
 mod solid_angle;
 mod uniform;
 
+pub use brdf_polygon::BrdfPolygon;
 pub use mis::{Heuristic, MisSettings};
 pub use projected_solid_angle::ProjectedSolidAngle;
 pub use solid_angle::SolidAngle;
@@ -231,6 +233,7 @@ registry! {
     Emitter => emitter::Emitter,
     SolidAngle => solid_angle::SolidAngle,
     ProjectedSolidAngle => projected_solid_angle::ProjectedSolidAngle,
+    BrdfPolygon => brdf_polygon::BrdfPolygon,
     Mis => mis::Mis,
 }
 
