@@ -5,6 +5,7 @@ mod discrete;
 mod hemisphere;
 mod ltc;
 mod phong_lobe;
+mod phong_ltc_table;
 mod projected_triangle;
 mod spherical_triangle;
 mod triangle;
@@ -13,7 +14,7 @@ pub use discrete::DiscreteDistribution;
 pub use hemisphere::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };
-pub use ltc::{PhongLtc, phong_ltc_scale_squared};
+pub use ltc::{LobeSamples, Ltc, PhongLtc, PhongLtcParameters, phong_ltc_scale_squared};
 pub use phong_lobe::{phong_lobe_pdf, phong_lobe_pdf_from_gap, sample_phong_lobe};
 pub use projected_triangle::{
     MIN_ACCEPTANCE, ProjectedPlan, max_cosine, projected_solid_angle, projected_triangle_pdf, sample_projected_triangle,

@@ -1,18 +1,19 @@
 //! BRDF-weighted polygon sampling (after Peters 2021, "BRDF Importance Sampling for Polygonal Lights", ACM TOG
-//! 40(4), with an analytic LTC in place of his fitted table): pick a triangle Δ with p_Δ, then a direction over
-//! it with a density close to `f_r (ω·n)` there, from a one-sample mixture of two exact densities:
+//! 40(4), with an LTC fitted to the Phong lobe): pick a triangle Δ with p_Δ, then a direction over it with a
+//! density close to `f_r (ω·n)` there, from a one-sample mixture of two exact densities:
 //!
 //! - diffuse part: `(ω·n)⁺/Ω⊥` — projected-solid-angle sampling of Δ about n;
-//! - specular part: `π D(ω)/Ω⊥(M⁻¹Δ)` over Δ — the isotropic linearly transformed cosine D fitted to the Phong
-//!   lobe about ω_r ([`PhongLtc`]): Δ is carried into cosine space by M⁻¹, sampled there by projected solid
-//!   angle, and the direction carried back by M;
+//! - specular part: `π D(ω)/Ω⊥(M⁻¹Δ)` over Δ — D the linearly transformed cosine fitted to the Phong lobe times
+//!   the cosine ([`PhongLtc`], a table over (α, θ_o) by `examples/fit_phong_ltc.rs`): Δ is carried into cosine
+//!   space by M⁻¹, sampled there by projected solid angle, and the direction carried back by M;
 //!
 //! chosen with `P_d = W_d/(W_d + W_s)`, where `W_d = max(k̄_d, 0.01) Ω⊥/π` and
-//! `W_s = k̄_s min(Ω⊥(M⁻¹Δ)/π, (α+1)/(2π) c_max^α Ω_Δ) max(ω_r·n, 0.05)` estimate the two lobes' integrals over
-//! Δ. The min bounds the LTC's estimate by the lobe's largest value on Δ (c_max = max over Δ of ω·ω_r): the LTC
-//! has a heavier tail than cos^α, and without the bound a light far outside a narrow lobe would get a large
-//! specular share. The floor on k_d keeps the diffuse part, which covers all of Δ above the horizon, in every
-//! mixture: any positive weights keep the estimator unbiased.
+//! `W_s = k̄_s min(Z Ω⊥(M⁻¹Δ)/π, (α+1)/(2π) c_max^α Ω⊥)` estimate the two lobes' integrals over Δ (Z the lobe's
+//! mass above the horizon, which the LTC's unit mass stands for). The min bounds the LTC's estimate by the lobe's
+//! largest value on Δ (c_max = max over Δ of ω·ω_r) times Δ's projected solid angle: the LTC has a heavier tail
+//! than cos^α, and without the bound a light far outside a narrow lobe would get a large specular share. The
+//! floor on k_d keeps the diffuse part, which covers all of Δ above the horizon, in every mixture: any positive
+//! weights keep the estimator unbiased.
 //!
 //! `p(ω) = p_Δ [P_d (ω·n)⁺/Ω⊥ + (1 − P_d) π D(ω)/Ω⊥(M⁻¹Δ)]`, exact for any ω that reaches Δ.
 //!
@@ -32,7 +33,7 @@ use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, 
 use crate::math::{SampleRng, luminance, reflect};
 use crate::render::ShadingPoint;
 use crate::sampling::{
-    MAX_SPHERICAL_SAMPLE_AREA, MIN_ACCEPTANCE, MIN_SPHERICAL_SAMPLE_AREA, PhongLtc, ProjectedPlan, max_cosine,
+    Ltc, MAX_SPHERICAL_SAMPLE_AREA, MIN_ACCEPTANCE, MIN_SPHERICAL_SAMPLE_AREA, PhongLtc, ProjectedPlan, max_cosine,
     projected_solid_angle, projected_triangle_pdf, sample_cosine_hemisphere, sample_projected_triangle,
     spherical_triangle_area,
 };
@@ -44,8 +45,6 @@ pub struct BrdfPolygon;
 
 /// The least diffuse albedo the mixture weighs the diffuse part with (Peters' floor).
 const DIFFUSE_FLOOR: f64 = 0.01;
-/// The least cosine factor of the specular weight, at grazing ω_r.
-const COSINE_FLOOR: f64 = 0.05;
 /// Draws of the whole cosine lobe before giving up (acceptance ≥ 5%: reached with probability 0.95¹⁰⁰⁰⁰).
 const MAX_TRIALS: u32 = 10_000;
 
@@ -64,9 +63,9 @@ enum Specular {
     /// No specular part (k_s = 0, or Δ entirely behind the lobe's axis).
     None,
     /// Projected-solid-angle sampling of M⁻¹Δ in cosine space (rejection from its spherical triangle).
-    Rejection { ltc: PhongLtc, tri: [Vec3; 3], cos_max: f32, projected: f64 },
+    Rejection { ltc: Ltc, tri: [Vec3; 3], cos_max: f32, projected: f64 },
     /// The whole cosine lobe, drawn until it meets M⁻¹Δ.
-    WholeLobe { ltc: PhongLtc, tri: [DVec3; 3], projected: f64 },
+    WholeLobe { ltc: Ltc, tri: [DVec3; 3], projected: f64 },
     /// Uniform points on Δ.
     Area,
 }
@@ -77,7 +76,7 @@ pub struct Weights {
     /// Ω⊥ of Δ about n.
     projected: f32,
     /// The lobe's LTC and Δ in its cosine space, with Ω⊥(M⁻¹Δ); `None` without a specular part.
-    lobe: Option<(PhongLtc, [DVec3; 3], f64)>,
+    lobe: Option<(Ltc, [DVec3; 3], f64)>,
     w_d: f64,
     w_s: f64,
 }
@@ -94,18 +93,19 @@ impl Weights {
         let w_d = (m.kd.element_sum() as f64 / 3.0).max(DIFFUSE_FLOOR) * projected as f64 * FRAC_1_PI;
         let ks = m.ks.element_sum() as f64 / 3.0;
         let (mut lobe, mut w_s) = (None, 0.0);
-        if ks > 0.0 {
-            let wr = reflect(sp.wo, sp.n);
-            let ltc = PhongLtc::new(wr, m.alpha);
+        if ks > 0.0
+            && let Some(PhongLtc { ltc, mass }) = PhongLtc::new(n, sp.wo, m.alpha)
+        {
             let cosine_space = tri.v.map(|v| ltc.to_cosine_space((v - p).as_dvec3()));
             let [ca, cb, cc] = cosine_space.map(DVec3::as_vec3);
             let projected_lobe = projected_solid_angle(Vec3::ZERO, Vec3::Z, ca, cb, cc) as f64;
             if projected_lobe > 0.0 {
                 let alpha = m.alpha as f64;
-                let bound = (alpha + 1.0) / (2.0 * PI)
-                    * (max_cosine(p, wr, a, b, c) as f64).powf(alpha)
-                    * spherical_triangle_area(p, a, b, c) as f64;
-                w_s = ks * (projected_lobe * FRAC_1_PI).min(bound) * (wr.dot(n) as f64).max(COSINE_FLOOR);
+                let wr = reflect(sp.wo, n);
+                // ∫_Δ lobe (ω·n) dω ≤ the lobe's largest value on Δ times ∫_Δ (ω·n) dω.
+                let bound =
+                    (alpha + 1.0) / (2.0 * PI) * (max_cosine(p, wr, a, b, c) as f64).powf(alpha) * projected as f64;
+                w_s = ks * (mass * projected_lobe * FRAC_1_PI).min(bound);
                 lobe = Some((ltc, cosine_space, projected_lobe));
             }
         }
@@ -176,7 +176,7 @@ impl Plan {
 }
 
 /// How the specular part samples M⁻¹Δ (`tri`, of projected solid angle `projected` in cosine space).
-fn specular_plan(ltc: PhongLtc, tri: [DVec3; 3], projected: f64) -> Specular {
+fn specular_plan(ltc: Ltc, tri: [DVec3; 3], projected: f64) -> Specular {
     let tri_f32 = tri.map(DVec3::as_vec3);
     let [a, b, c] = tri_f32;
     let solid_angle = spherical_triangle_area(Vec3::ZERO, a, b, c);
@@ -194,7 +194,7 @@ fn specular_plan(ltc: PhongLtc, tri: [DVec3; 3], projected: f64) -> Specular {
 }
 
 /// A direction of the whole LTC, drawn until its cosine-space direction meets `tri` (density D(ω)/∫_Δ D).
-fn sample_whole_lobe(ltc: &PhongLtc, tri: &[DVec3; 3], rng: &mut SampleRng) -> Option<Vec3> {
+fn sample_whole_lobe(ltc: &Ltc, tri: &[DVec3; 3], rng: &mut SampleRng) -> Option<Vec3> {
     let [a, b, c] = *tri;
     let (ab, bc, ca) = (a.cross(b), b.cross(c), c.cross(a));
     let orientation = a.dot(bc);
