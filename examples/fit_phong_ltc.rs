@@ -135,7 +135,7 @@ fn main() {
     writeln!(out, "/// θ_o (radians) at the table's nodes.").unwrap();
     writeln!(out, "pub const THETA_NODES: [f64; {THETA_COUNT}] = {theta_nodes:?};").unwrap();
     writeln!(out, "/// (A, B, C, T, Z) at each (α, θ_o) node, α major.").unwrap();
-    writeln!(out, "pub const PARAMETERS: [[f64; 5]; {}] = [", table.len()).unwrap();
+    writeln!(out, "pub static PARAMETERS: [[f64; 5]; {}] = [", table.len()).unwrap();
     for row in &table {
         writeln!(out, "    {row:?},").unwrap();
     }

@@ -46,7 +46,7 @@ fn axial_moment(poly: &[DVec3], w: DVec3, k: u32) -> f64 {
         let sum: f64 = (0..k).rev().step_by(2).map(|i| j[i as usize]).sum();
         boundary += edge.normal.dot(w) * sum;
     }
-    let even = if k % 2 == 0 { omega } else { 0.0 };
+    let even = if k.is_multiple_of(2) { omega } else { 0.0 };
     (even - boundary) / (k as f64 + 1.0)
 }
 
