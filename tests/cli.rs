@@ -332,8 +332,18 @@ fn obj_nan_vertex_is_an_error() {
 }
 
 #[test]
-fn missing_mtl_is_an_error() {
-    assert_bad_scene(TOML, &edit(OBJ, "mtllib scene.mtl", "mtllib absent.mtl"), MTL, &["absent.mtl"]);
+fn missing_mtl_is_a_warning_and_renders_with_the_default_material() {
+    let dir = TempDir::new().unwrap();
+    let scene = write_scene(dir.path(), TOML, &edit(OBJ, "mtllib scene.mtl", "mtllib absent.mtl"), MTL);
+    let out = dir.path().join("out.png");
+    let output = run(render_args(&scene, &out, &[("--spp", "1")]));
+    assert_success(&output);
+    let err = stderr(&output);
+    assert!(
+        err.lines().any(|l| l.contains("warning") && l.contains("absent.mtl") && l.contains("default grey")),
+        "no warning naming the missing file:\n{err}"
+    );
+    assert!(out.is_file());
 }
 
 #[test]

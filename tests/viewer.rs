@@ -159,6 +159,27 @@ fn a_broken_scene_file_shows_an_error_and_the_previous_scene_stays_usable() {
 }
 
 #[test]
+fn a_scene_whose_mtl_is_missing_loads_and_says_so() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = dir.path().join("lonely.obj");
+    std::fs::write(&obj, "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl marble\nf 1 2 3\n").expect("write");
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_by_label("file").focus();
+    h.step();
+    h.get_by_label("file").type_text(&obj.to_string_lossy());
+    h.step();
+    h.get_by_label("Open").click();
+    h.step();
+    step_until(&mut h, "loading to end", |v| !v.is_loading());
+    h.step();
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    assert_eq!(h.state().scene().name, "lonely");
+    assert!(h.query_by_label_contains("no such MTL file").is_some(), "the missing MTL is on screen");
+    assert!(h.query_by_label_contains("marble").is_some(), "the unknown material is on screen");
+}
+
+#[test]
 fn choosing_a_bundled_scene_loads_it_in_the_background() {
     let mut h = harness(viewer());
     step_until(&mut h, "a frame", |v| v.frame().is_some());

@@ -51,6 +51,10 @@ fn scene_ui(v: &mut Viewer, ui: &mut egui::Ui) {
             ui.label(format!("loading {} ({:.1} s)", l.what, l.started.elapsed().as_secs_f32()));
         });
     }
+    // What loading ignored or replaced (MTL statements, missing files, degenerate triangles): never silent.
+    for w in &v.scene.warnings {
+        ui.colored_label(ui.visuals().warn_fg_color, format!("warning: {w}"));
+    }
 }
 
 fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {

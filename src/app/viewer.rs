@@ -388,7 +388,8 @@ impl Viewer {
                 self.home_camera = scene.camera;
                 self.camera = scene.camera;
                 self.selected_material = 0;
-                self.message = scene.warnings.first().map(|w| format!("{}: {w}", scene.name));
+                // The scene's warnings are shown under the scene, for as long as it is loaded.
+                self.message = None;
                 self.scene = Arc::new(scene);
                 self.send_restarting(Command::SetScene(self.scene.clone()));
             }

@@ -16,13 +16,14 @@
 //! first, so that (w·u)^k and (n·u) are the clamped ones the Phong BRDF has. An edge that the clipping lays on
 //! the great circle w·u = 0 has J_i = 0 for i > 0 but still J₀ = Θ_e: it contributes to the sums above.
 
+use super::polygon::clip_to_half_space;
 use glam::DVec3;
 
 /// `∫_{P ∩ H_n ∩ H_w} (ω·w)^k (ω·n) dω` over the directions from p through the planar polygon `vertices`, H_n
 /// and H_w the hemispheres about n and w (unit vectors). Exact up to rounding; O(k) per edge.
 pub fn phong_polygon_moment(p: DVec3, n: DVec3, w: DVec3, k: u32, vertices: &[DVec3]) -> f64 {
     let rel: Vec<DVec3> = vertices.iter().map(|v| *v - p).collect();
-    let clipped = clip(&clip(&rel, n), w);
+    let clipped = clip_to_half_space(&clip_to_half_space(&rel, n), w);
     let Some(poly) = spherical_polygon(&clipped) else { return 0.0 };
     let k_f = k as f64;
     let mut boundary = 0.0;
@@ -126,24 +127,6 @@ fn solid_angle(poly: &[DVec3]) -> f64 {
             2.0 * num.atan2(den)
         })
         .sum()
-}
-
-/// Sutherland–Hodgman clip of a polygon (relative to p) against the half-space x·axis ≥ 0.
-fn clip(poly: &[DVec3], axis: DVec3) -> Vec<DVec3> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (da, db) = (a.dot(axis), b.dot(axis));
-        if da >= 0.0 {
-            out.push(a);
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            let cut = a + (b - a) * (da / (da - db));
-            // On the plane exactly, so that the edge lies on the great circle x·axis = 0.
-            out.push(cut - axis * cut.dot(axis));
-        }
-    }
-    out
 }
 
 #[cfg(test)]

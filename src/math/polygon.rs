@@ -27,16 +27,22 @@ pub fn lambert_polygon_irradiance(p: DVec3, n: DVec3, vertices: &[DVec3], radian
 /// Sutherland–Hodgman clip of the polygon (relative to p) against the plane n·x ≥ 0.
 fn clip_to_hemisphere(p: DVec3, n: DVec3, vertices: &[DVec3]) -> Vec<DVec3> {
     let rel: Vec<DVec3> = vertices.iter().map(|v| *v - p).collect();
-    let mut out = Vec::with_capacity(rel.len() + 2);
-    for i in 0..rel.len() {
-        let (a, b) = (rel[i], rel[(i + 1) % rel.len()]);
-        let (da, db) = (a.dot(n), b.dot(n));
+    clip_to_half_space(&rel, n)
+}
+
+/// Sutherland–Hodgman clip of a polygon (relative to the point it is seen from) against the half-space
+/// x·axis ≥ 0. A cut vertex is put on the plane exactly, so that a cut edge lies on the great circle x·axis = 0.
+pub(super) fn clip_to_half_space(poly: &[DVec3], axis: DVec3) -> Vec<DVec3> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (da, db) = (a.dot(axis), b.dot(axis));
         if da >= 0.0 {
             out.push(a);
         }
         if (da >= 0.0) != (db >= 0.0) {
-            let t = da / (da - db);
-            out.push(a + (b - a) * t);
+            let cut = a + (b - a) * (da / (da - db));
+            out.push(cut - axis * (cut.dot(axis) / axis.length_squared()));
         }
     }
     out

@@ -72,8 +72,13 @@ pub fn projected_triangle_pdf(cos_theta: f32, projected_solid_angle: f32) -> f32
 /// Projected solid angle Ω⊥ of the triangle (a, b, c) seen from p with unit normal n, only the part above the
 /// horizon: Lambert's `½ |Σ Θ_i (n·γ_i)|` over the triangle clipped to n·(x − p) ≥ 0. In f64, no allocation.
 pub fn projected_solid_angle(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
-    let n = n.as_dvec3();
-    let rel = [(a - p).as_dvec3(), (b - p).as_dvec3(), (c - p).as_dvec3()];
+    let rel = [a - p, b - p, c - p].map(Vec3::as_dvec3);
+    projected_solid_angle_f64(n.as_dvec3(), rel) as f32
+}
+
+/// [`projected_solid_angle`] of a triangle given in f64 relative to the point (the LTC's cosine space, where
+/// rounding the vertices to f32 would move a plane that passes close to the origin).
+pub fn projected_solid_angle_f64(n: DVec3, rel: [DVec3; 3]) -> f64 {
     let mut poly = [DVec3::ZERO; 4];
     let mut len = 0;
     for i in 0..3 {
@@ -98,7 +103,7 @@ pub fn projected_solid_angle(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32
         sum += theta * n.dot(u.cross(v).normalize_or_zero());
     }
     let result = 0.5 * sum.abs();
-    if result.is_finite() { result as f32 } else { 0.0 }
+    if result.is_finite() { result } else { 0.0 }
 }
 
 /// max of ω·n over the spherical triangle of (a, b, c) seen from p: 1 where n points into it, else the largest

@@ -4,6 +4,7 @@
 use super::bundled::{self, BundledScene};
 use super::file::{MaterialOverride, MeshSpec, SceneFile};
 use super::material::validate;
+use super::mtl::clean_mtl;
 use super::{Camera, Material, Scene, SceneError};
 use glam::Vec3;
 use std::cell::RefCell;
@@ -96,6 +97,8 @@ struct Meshes {
     materials: Vec<Material>,
     names: Vec<String>,
     default_material: Option<u32>,
+    /// What was loaded differently from what the files say (ignored statements, missing files), one line each.
+    warnings: Vec<String>,
 }
 
 impl Meshes {
@@ -106,15 +109,39 @@ impl Meshes {
         let text = source.read(&obj_path)?;
         let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
         let mtl_paths: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
+        let warnings: RefCell<Vec<String>> = RefCell::new(Vec::new());
         let options =
             tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
         let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |mtl| {
             let mtl_path = obj_dir.join(mtl);
-            let result = source.read(&mtl_path).and_then(|t| {
-                check_mtl_colours(&t).map_err(|message| SceneError::Mtl { path: mtl_path.clone(), message })?;
-                tobj::load_mtl_buf(&mut t.as_bytes())
-                    .map_err(|e| SceneError::Mtl { path: mtl_path.clone(), message: e.to_string() })
-            });
+            let text = match source.read(&mtl_path) {
+                Ok(text) => Some(text),
+                Err(SceneError::Io { path, cause }) if cause.kind() == std::io::ErrorKind::NotFound => {
+                    warnings.borrow_mut().push(format!(
+                        "{}: no such MTL file ({}): its materials are replaced by the default grey (k_d = 0.5)",
+                        obj_path.display(),
+                        path.display()
+                    ));
+                    None
+                }
+                Err(e) => {
+                    mtl_error.borrow_mut().get_or_insert(e);
+                    return Err(tobj::LoadError::GenericFailure);
+                }
+            };
+            let result = clean_mtl(text.as_deref().unwrap_or_default())
+                .map_err(|message| SceneError::Mtl { path: mtl_path.clone(), message })
+                .and_then(|clean| {
+                    if !clean.ignored.is_empty() {
+                        warnings.borrow_mut().push(format!(
+                            "{}: ignored (the Phong model has no use for them): {}",
+                            mtl_path.display(),
+                            clean.ignored.join(", ")
+                        ));
+                    }
+                    tobj::load_mtl_buf(&mut clean.text.as_bytes())
+                        .map_err(|e| SceneError::Mtl { path: mtl_path.clone(), message: e.to_string() })
+                });
             mtl_paths.borrow_mut().push(mtl_path);
             result.map_err(|e| {
                 mtl_error.borrow_mut().get_or_insert(e);
@@ -127,6 +154,15 @@ impl Meshes {
         }
         let materials = materials.map_err(|e| SceneError::Mtl { path: obj_path.clone(), message: e.to_string() })?;
         let mtl_path = mtl_paths.into_inner().pop().unwrap_or_else(|| obj_path.clone());
+        self.warnings.extend(warnings.into_inner());
+        let unknown = unknown_materials(&text, &materials);
+        if !unknown.is_empty() {
+            self.warnings.push(format!(
+                "{}: usemtl of material(s) no MTL defines ({}): those faces get the default grey (k_d = 0.5)",
+                obj_path.display(),
+                unknown.join(", ")
+            ));
+        }
 
         for name in spec.materials.keys() {
             if !materials.iter().any(|m| &m.name == name) {
@@ -185,10 +221,13 @@ impl Meshes {
     }
 
     fn into_scene(self, name: String, camera: Camera, path: &Path) -> Result<Scene, SceneError> {
-        Scene::new(name, camera, &self.positions, &self.material_ids, self.materials, self.names).map_err(|e| match e {
-            SceneError::Invalid(message) => SceneError::Mesh { path: path.to_path_buf(), message },
-            other => other,
-        })
+        let mut scene = Scene::new(name, camera, &self.positions, &self.material_ids, self.materials, self.names)
+            .map_err(|e| match e {
+                SceneError::Invalid(message) => SceneError::Mesh { path: path.to_path_buf(), message },
+                other => other,
+            })?;
+        scene.warnings.splice(0..0, self.warnings);
+        Ok(scene)
     }
 }
 
@@ -218,16 +257,18 @@ fn auto_camera(positions: &[[Vec3; 3]]) -> Camera {
     Camera { eye: centre + Vec3::new(0.0, 0.0, distance), target: centre, up: Vec3::Y, fov_y, width: 512, height: 512 }
 }
 
-/// tobj 4.0 panics on a colour line with fewer than three numbers; reject those first, with the line number.
-fn check_mtl_colours(text: &str) -> Result<(), String> {
-    for (i, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        if let Some(key @ ("Ka" | "Kd" | "Ks" | "Ke")) = words.next() {
-            let numbers: Vec<&str> = words.collect();
-            if numbers.len() != 3 || numbers.iter().any(|w| w.parse::<f32>().is_err()) {
-                return Err(format!("line {}: {key} needs three numbers", i + 1));
-            }
+/// The names an OBJ's `usemtl` lines use that none of its materials has, each once.
+fn unknown_materials(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
+    let mut unknown: Vec<String> = Vec::new();
+    for line in obj.lines() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if let Some(name) = line.strip_prefix("usemtl").filter(|r| r.starts_with(char::is_whitespace)).map(str::trim)
+            && !name.is_empty()
+            && !materials.iter().any(|m| m.name == name)
+            && !unknown.iter().any(|u| u == name)
+        {
+            unknown.push(name.to_string());
         }
     }
-    Ok(())
+    unknown
 }

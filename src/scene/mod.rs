@@ -10,6 +10,7 @@ mod error;
 mod file;
 mod load;
 mod material;
+mod mtl;
 
 pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
 #[cfg(test)]

@@ -34,8 +34,8 @@ use crate::math::{SampleRng, luminance, reflect};
 use crate::render::ShadingPoint;
 use crate::sampling::{
     Ltc, MAX_SPHERICAL_SAMPLE_AREA, MIN_ACCEPTANCE, MIN_SPHERICAL_SAMPLE_AREA, PhongLtc, ProjectedPlan, max_cosine,
-    projected_solid_angle, projected_triangle_pdf, sample_cosine_hemisphere, sample_projected_triangle,
-    spherical_triangle_area,
+    projected_solid_angle, projected_solid_angle_f64, projected_triangle_pdf, sample_cosine_hemisphere,
+    sample_projected_triangle, spherical_triangle_area,
 };
 use crate::scene::{LightSelection, Triangle};
 use glam::{DVec3, Vec3};
@@ -50,7 +50,7 @@ const MAX_TRIALS: u32 = 10_000;
 
 /// How directions towards one triangle are drawn from one shading point: a deterministic function of (p, n,
 /// ω_o, material, Δ), so that the density can be evaluated for any direction.
-pub struct Plan {
+struct Plan {
     diffuse: ProjectedPlan,
     /// Ω⊥ of Δ about n.
     projected: f64,
@@ -60,7 +60,7 @@ pub struct Plan {
 }
 
 enum Specular {
-    /// No specular part (k_s = 0, or Δ entirely behind the lobe's axis).
+    /// No specular part (k_s = 0, Δ entirely behind the lobe's axis, or a lobe too narrow to reach Δ: W_s = 0).
     None,
     /// Projected-solid-angle sampling of M⁻¹Δ in cosine space (rejection from its spherical triangle).
     Rejection { ltc: Ltc, tri: [Vec3; 3], cos_max: f32, projected: f64 },
@@ -72,7 +72,7 @@ enum Specular {
 
 /// The mixture's weights, W_d and W_s, and the geometry they are computed from: all that the `contribution`
 /// light selection needs of a triangle; [`Weights::plan`] completes the plan for the one that is sampled.
-pub struct Weights {
+struct Weights {
     /// Ω⊥ of Δ about n.
     projected: f32,
     /// The lobe's LTC and Δ in its cosine space, with Ω⊥(M⁻¹Δ); `None` without a specular part.
@@ -83,7 +83,7 @@ pub struct Weights {
 
 impl Weights {
     /// `None` where nothing of Δ is above the horizon.
-    pub fn new(sp: &ShadingPoint, tri: &Triangle) -> Option<Self> {
+    fn new(sp: &ShadingPoint, tri: &Triangle) -> Option<Self> {
         let (p, n, [a, b, c]) = (sp.p, sp.n, tri.v);
         let projected = projected_solid_angle(p, n, a, b, c);
         if !(projected > 0.0) {
@@ -97,8 +97,7 @@ impl Weights {
             && let Some(PhongLtc { ltc, mass }) = PhongLtc::new(n, sp.wo, m.alpha)
         {
             let cosine_space = tri.v.map(|v| ltc.to_cosine_space((v - p).as_dvec3()));
-            let [ca, cb, cc] = cosine_space.map(DVec3::as_vec3);
-            let projected_lobe = projected_solid_angle(Vec3::ZERO, Vec3::Z, ca, cb, cc) as f64;
+            let projected_lobe = projected_solid_angle_f64(DVec3::Z, cosine_space);
             if projected_lobe > 0.0 {
                 let alpha = m.alpha as f64;
                 let wr = reflect(sp.wo, n);
@@ -113,12 +112,12 @@ impl Weights {
     }
 
     /// W_d + W_s: the estimated `∫_Δ f_r (ω·n) dω`.
-    pub fn total(&self) -> f64 {
+    fn total(&self) -> f64 {
         self.w_d + self.w_s
     }
 
     /// The sampling plan: each part's method, by the deterministic fallbacks of the module's docs.
-    pub fn plan(&self, sp: &ShadingPoint, tri: &Triangle) -> Plan {
+    fn plan(&self, sp: &ShadingPoint, tri: &Triangle) -> Plan {
         let [a, b, c] = tri.v;
         let diffuse = ProjectedPlan::with_projected(sp.p, sp.n, a, b, c, self.projected);
         let specular = match self.lobe {
@@ -131,7 +130,7 @@ impl Weights {
 
 impl Plan {
     /// `None` where nothing of Δ is above the horizon.
-    pub fn new(sp: &ShadingPoint, tri: &Triangle) -> Option<Self> {
+    fn new(sp: &ShadingPoint, tri: &Triangle) -> Option<Self> {
         Some(Weights::new(sp, tri)?.plan(sp, tri))
     }
 
