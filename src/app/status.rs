@@ -5,7 +5,8 @@ use super::viewer::Viewer;
 pub fn status_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     ui.horizontal_wrapped(|ui| {
         let Some(f) = v.frame.clone() else {
-            ui.label("starting…");
+            // Before the first frame: starting, or stopped (the error is at the top of the side panel).
+            ui.label(if v.error.is_some() { "not rendering: see the error" } else { "starting…" });
             return;
         };
         let seconds = f.elapsed.as_secs_f64().max(1e-9);

@@ -228,6 +228,9 @@ impl Viewer {
 
     /// The newest frames and reference from the worker, if any; records convergence; refreshes textures lazily.
     fn take_frames(&mut self) {
+        if let Some(failure) = self.worker.take_failure() {
+            self.error = Some(failure);
+        }
         if let Some(status) = self.worker.take_reference() {
             // Progress reports of the same render change neither the runs nor the maps.
             let progress = matches!(

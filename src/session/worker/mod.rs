@@ -82,6 +82,9 @@ pub enum Command {
     /// Use the reference in this EXR file (with its `.var.exr` sibling if present).
     LoadReference(PathBuf),
     Quit,
+    /// Tests: the next pass panics.
+    #[cfg(test)]
+    PanicInNextPass,
 }
 
 impl Command {
@@ -111,6 +114,8 @@ pub struct Worker {
 struct Slots {
     frames: [Mutex<Option<Arc<Frame>>>; 2],
     reference: Mutex<Option<ReferenceStatus>>,
+    /// What stopped the integrator (no thread, no pool, a pass that panicked), for the UI to show.
+    failure: Mutex<Option<String>>,
 }
 
 /// Counters the UI bumps and passes poll.
@@ -135,8 +140,22 @@ impl Worker {
         let shared = Arc::new(Shared::default());
         let state = State::new(scene, settings, latest.clone(), shared.clone(), Box::new(notify));
         let thread =
-            std::thread::Builder::new().name("integrator".into()).spawn(move || state.run(rx, threads.max(1))).ok();
+            match std::thread::Builder::new().name("integrator".into()).spawn(move || state.run(rx, threads.max(1))) {
+                Ok(thread) => Some(thread),
+                Err(e) => {
+                    if let Ok(mut slot) = latest.failure.lock() {
+                        *slot = Some(format!("cannot start the integrator thread: {e}"));
+                    }
+                    None
+                }
+            };
         Self { commands, latest, shared, thread }
+    }
+
+    /// Why the integrator stopped, if it did since the last call: the UI shows it (rendering resumes, if it
+    /// can, with the next command that restarts an image).
+    pub fn take_failure(&self) -> Option<String> {
+        self.latest.failure.lock().ok()?.take()
     }
 
     /// Sends a command; one that changes an image cancels that image's pass in flight first. The generation
@@ -216,6 +235,20 @@ struct State {
     latest: Arc<Slots>,
     shared: Arc<Shared>,
     notify: Box<dyn Fn() + Send>,
+    /// A pass panicked: nothing renders until a command restarts an image.
+    stalled: bool,
+    /// Tests: make the next pass panic.
+    #[cfg(test)]
+    panic_in_next_pass: bool,
+}
+
+/// The text of a panic's payload.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".into())
 }
 
 impl State {
@@ -247,7 +280,18 @@ impl State {
             latest,
             shared,
             notify,
+            stalled: false,
+            #[cfg(test)]
+            panic_in_next_pass: false,
         }
+    }
+
+    /// Tells the UI why the integrator stopped.
+    fn report_failure(&self, message: String) {
+        if let Ok(mut slot) = self.latest.failure.lock() {
+            *slot = Some(message);
+        }
+        (self.notify)();
     }
 
     fn lane_count(&self) -> usize {
@@ -281,14 +325,23 @@ impl State {
     /// `threads` run the passes; the first pass after a restart uses every core, so that a new setting shows as
     /// soon as possible (the UI is idle then).
     fn run(mut self, rx: Receiver<(u64, Command)>, threads: usize) {
-        let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(threads).build() else { return };
         let all = std::thread::available_parallelism().map_or(threads, |n| n.get().max(threads));
-        let Ok(first_pool) = rayon::ThreadPoolBuilder::new().num_threads(all).build() else { return };
+        let pools = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .and_then(|pool| Ok((pool, rayon::ThreadPoolBuilder::new().num_threads(all).build()?)));
+        let (pool, first_pool) = match pools {
+            Ok(pools) => pools,
+            Err(e) => {
+                self.report_failure(format!("cannot start the integrator's {all} threads: {e}"));
+                return;
+            }
+        };
         loop {
             // Apply every pending command; block only when there is nothing to render.
             let mut changed = false;
             loop {
-                let nothing_to_do = self.next_lane().is_none() && !self.reference_pending();
+                let nothing_to_do = self.stalled || (self.next_lane().is_none() && !self.reference_pending());
                 let (generation, command) = if nothing_to_do && !changed {
                     match rx.recv() {
                         Ok(c) => c,
@@ -310,20 +363,42 @@ impl State {
                 }
             }
             if changed {
+                self.stalled = false;
                 self.reset_what_changed();
             }
-            if let Some(i) = (0..self.lane_count()).find(|&i| !self.lanes[i].previewed && !self.lane_idle(i)) {
-                self.preview(i, &first_pool);
+            if self.stalled {
                 continue;
             }
-            let lane = self.next_lane();
-            let reference_turn = self.reference_pending() && (lane.is_none() || self.turn % 2 == 1);
-            self.turn += 1;
-            match lane {
-                _ if reference_turn => self.reference_pass(if lane.is_none() { &first_pool } else { &pool }),
-                Some(i) => self.pass(i, if self.lanes[i].passes == 0 { &first_pool } else { &pool }),
-                None => {}
+            // A pass that panics (a bug) stops rendering, not the thread: the UI is told, and the next command
+            // that restarts an image starts again.
+            let step = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.step(&pool, &first_pool)));
+            if let Err(payload) = step {
+                self.stalled = true;
+                self.report_failure(format!(
+                    "rendering stopped: a pass panicked ({}); change a setting to try again",
+                    panic_message(payload.as_ref())
+                ));
             }
+        }
+    }
+
+    /// One preview or pass: the lane or reference whose turn it is.
+    fn step(&mut self, pool: &rayon::ThreadPool, first_pool: &rayon::ThreadPool) {
+        #[cfg(test)]
+        if std::mem::take(&mut self.panic_in_next_pass) {
+            panic!("a fault injected by a test");
+        }
+        if let Some(i) = (0..self.lane_count()).find(|&i| !self.lanes[i].previewed && !self.lane_idle(i)) {
+            self.preview(i, first_pool);
+            return;
+        }
+        let lane = self.next_lane();
+        let reference_turn = self.reference_pending() && (lane.is_none() || self.turn % 2 == 1);
+        self.turn += 1;
+        match lane {
+            _ if reference_turn => self.reference_pass(if lane.is_none() { first_pool } else { pool }),
+            Some(i) => self.pass(i, if self.lanes[i].passes == 0 { first_pool } else { pool }),
+            None => {}
         }
     }
 
@@ -365,6 +440,8 @@ impl State {
             }
             Command::LoadReference(path) => self.reference_file = Some(path),
             Command::Quit => return false,
+            #[cfg(test)]
+            Command::PanicInNextPass => self.panic_in_next_pass = true,
         }
         true
     }

@@ -172,3 +172,23 @@ fn a_bad_reference_file_is_reported() {
     assert!(message.contains("/nonexistent/ref.exr"), "{message}");
     wait_for(&worker, |f| f.spp >= 2);
 }
+
+#[test]
+fn a_pass_that_panics_reaches_the_ui_and_a_new_setting_renders_again() {
+    let worker = Worker::spawn(small_scene(), RenderSettings::default(), 1, || {});
+    wait_for(&worker, |f| f.spp >= 1);
+    worker.send(Command::PanicInNextPass);
+    let start = Instant::now();
+    let failure = loop {
+        if let Some(f) = worker.take_failure() {
+            break f;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "the failure never reached the handle");
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    assert!(failure.contains("panicked") && failure.contains("injected"), "{failure}");
+    // Stalled, not dead: the next command that restarts an image renders again.
+    worker.send(Command::SetSettings(settings(Strategy::Cosine)));
+    let f = wait_for(&worker, |f| f.settings.strategy == Strategy::Cosine && f.spp >= 2);
+    assert!(f.radiance.iter().all(|v| v.is_finite()));
+}
