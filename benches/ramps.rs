@@ -14,9 +14,13 @@ use rayon::prelude::*;
 use std::time::Instant;
 
 const SLABS: [&str; 4] = ["slab_a1", "slab_a30", "slab_a300", "slab_a3000"];
-const POINTS_PER_SLAB: usize = 48;
-const SAMPLES: u64 = 20_000;
-const SEEDS: u64 = 4;
+/// How much to measure: `cargo bench` measures, `cargo test --all-targets` (no `--bench`) only checks that it runs.
+#[derive(Clone, Copy)]
+struct Budget {
+    points_per_slab: usize,
+    samples: u64,
+    seeds: u64,
+}
 
 fn configurations() -> Vec<(String, RenderSettings)> {
     let single = |s: Strategy, light_selection: LightSelection| {
@@ -45,6 +49,12 @@ fn configurations() -> Vec<(String, RenderSettings)> {
 }
 
 fn main() {
+    let budget = if std::env::args().any(|a| a == "--bench") {
+        Budget { points_per_slab: 48, samples: 20_000, seeds: 4 }
+    } else {
+        Budget { points_per_slab: 2, samples: 100, seeds: 1 }
+    };
+    let Budget { points_per_slab, samples, seeds } = budget;
     let scene = load_scene("default").expect("bundled scene");
     let camera = scene.camera;
     let start = Instant::now();
@@ -58,8 +68,8 @@ fn main() {
             .filter_map(|pixel| ProbePoint::at_pixel(&scene, &camera, pixel))
             .filter(|p| p.material == material)
             .collect();
-        let stride = (candidates.len() / POINTS_PER_SLAB).max(1);
-        let chosen: Vec<ProbePoint> = candidates.into_iter().step_by(stride).take(POINTS_PER_SLAB).collect();
+        let stride = (candidates.len() / points_per_slab).max(1);
+        let chosen: Vec<ProbePoint> = candidates.into_iter().step_by(stride).take(points_per_slab).collect();
         let with_truth: Vec<(ProbePoint, f64)> = chosen
             .into_par_iter()
             .map(|p| {
@@ -72,7 +82,7 @@ fn main() {
     }
     eprintln!("points and quadratures in {:.1} s", start.elapsed().as_secs_f64());
 
-    println!("\n### default, fixed shading points, {SAMPLES} samples × {SEEDS} seeds per point\n");
+    println!("\n### default, fixed shading points, {samples} samples × {seeds} seeds per point\n");
     println!(
         "relMSE of a one-ray estimate, `E[(Y − Y_ref)²]/Y_ref² × rays per sample`, mean over each slab's points \
          (lower is better); min–max over the seeds in brackets\n"
@@ -86,7 +96,7 @@ fn main() {
         let mut cells = Vec::new();
         let mut rays_per_sample = 0.0;
         for slab_points in &points {
-            let per_seed: Vec<(f64, f64)> = (0..SEEDS)
+            let per_seed: Vec<(f64, f64)> = (0..seeds)
                 .map(|seed| {
                     let (sum, rays): (f64, u64) = slab_points
                         .par_iter()
@@ -94,16 +104,16 @@ fn main() {
                             let sp = p.shading_point(&scene);
                             let settings = RenderSettings { seed: 1000 * seed + p.pixel.0 as u64, ..settings };
                             let (mut sq, mut rays) = (0.0, 0u64);
-                            for i in 0..SAMPLES {
+                            for i in 0..samples {
                                 let mut rng = SampleRng::new(settings.seed, p.pixel.1 as u64, i);
                                 let v = estimate_direct(&scene, &sp, &settings, emitters.as_ref(), &mut rng, &mut rays);
                                 let y = if v.is_finite() { luminance(v) as f64 } else { 0.0 };
                                 sq += (y - truth).powi(2);
                             }
-                            (sq / SAMPLES as f64 / (truth * truth), rays)
+                            (sq / samples as f64 / (truth * truth), rays)
                         })
                         .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
-                    let rays = rays as f64 / (SAMPLES as f64 * slab_points.len() as f64);
+                    let rays = rays as f64 / (samples as f64 * slab_points.len() as f64);
                     (sum / slab_points.len() as f64, rays)
                 })
                 .collect();
@@ -144,7 +154,7 @@ fn main() {
             .collect();
         println!("| {name} | {} |", text.join(" | "));
     }
-    grazing_table();
+    grazing_table(budget);
     eprintln!("done in {:.1} s", start.elapsed().as_secs_f64());
 }
 
@@ -160,7 +170,7 @@ fn sig(v: f64) -> String {
 /// Grazing views, where the isotropic LTC (fitted to the lobe alone) ignores that `(ω·n)` cuts the lobe: a glossy
 /// floor (k_d = 0.2, k_s = 0.6) and a 0.6 m triangle light 1 m away centred on ω_r, for views from 0° to 89°.
 /// The truth is the closed form (Lambert plus Arvo's moment); relMSE at one ray as above, one point per view.
-fn grazing_table() {
+fn grazing_table(Budget { samples, seeds, .. }: Budget) {
     use glam::{DVec3, Vec3};
     use illumlab::math::{lambert_polygon_irradiance, phong_polygon_moment, reflect};
     use illumlab::render::ShadingPoint;
@@ -168,7 +178,7 @@ fn grazing_table() {
     let camera =
         Camera { eye: Vec3::new(0.0, 1.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y: 40.0, width: 8, height: 8 };
     println!(
-        "\n### A glossy floor under a triangle light centred on ω_r, by view angle ({SAMPLES} samples × {SEEDS} seeds)\n"
+        "\n### A glossy floor under a triangle light centred on ω_r, by view angle ({samples} samples × {seeds} seeds)\n"
     );
     println!("relMSE of a one-ray estimate (lower is better); min–max over the seeds\n");
     println!("| α | view | brdf-polygon | mis (projected-solid-angle + brdf) | mis ÷ brdf-polygon |");
@@ -205,17 +215,17 @@ fn grazing_table() {
                     * phong_polygon_moment(pd, DVec3::Y, wrd, alpha as u32, &poly);
             let rel = |settings: RenderSettings| -> [f64; 3] {
                 let emitters = EmitterSampler::new(&scene, settings.light_selection);
-                let values: Vec<f64> = (0..SEEDS)
+                let values: Vec<f64> = (0..seeds)
                     .into_par_iter()
                     .map(|seed| {
                         let (mut sq, mut rays) = (0.0, 0u64);
-                        for i in 0..SAMPLES {
+                        for i in 0..samples {
                             let mut rng = SampleRng::new(seed, 7, i);
                             let v = estimate_direct(&scene, &sp, &settings, emitters.as_ref(), &mut rng, &mut rays);
                             let y = if v.is_finite() { v.x as f64 } else { 0.0 };
                             sq += (y - truth).powi(2);
                         }
-                        sq / SAMPLES as f64 / (truth * truth) * rays as f64 / SAMPLES as f64
+                        sq / samples as f64 / (truth * truth) * rays as f64 / samples as f64
                     })
                     .collect();
                 let mean = values.iter().sum::<f64>() / values.len() as f64;

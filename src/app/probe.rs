@@ -190,13 +190,15 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         return;
     };
     let material = v.scene.material_names.get(point.material as usize).map_or("?", |s| s.as_str());
+    // In the scene files' coordinates (a scene far from the origin renders rebased).
+    let position = v.scene.origin + point.position.as_dvec3();
     ui.label(format!(
         "pixel {},{}  p = ({:.3}, {:.3}, {:.3})  n = ({:.2}, {:.2}, {:.2})  ω_o = ({:.2}, {:.2}, {:.2})  material {material}{}",
         point.pixel.0,
         point.pixel.1,
-        point.position.x,
-        point.position.y,
-        point.position.z,
+        position.x,
+        position.y,
+        position.z,
         point.normal.x,
         point.normal.y,
         point.normal.z,

@@ -97,7 +97,13 @@ pub fn probe(args: ProbeArgs) -> Result<()> {
     let p = &point;
     println!(
         "{} pixel {},{}: p = {:.4} n = {:.4} ω_o = {:.4} material {}",
-        scene.name, p.pixel.0, p.pixel.1, p.position, p.normal, p.wo, p.material
+        scene.name,
+        p.pixel.0,
+        p.pixel.1,
+        scene.origin + p.position.as_dvec3(), // in the scene files' coordinates
+        p.normal,
+        p.wo,
+        p.material
     );
     println!(
         "strategy {}: {} samples, {:.3} M samples/s (one thread)",

@@ -30,8 +30,9 @@ pub struct SceneFile {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraSpec {
-    pub eye: [f32; 3],
-    pub target: [f32; 3],
+    // f64: a scene kilometres from the origin is rebased before it is rounded to f32.
+    pub eye: [f64; 3],
+    pub target: [f64; 3],
     pub up: [f32; 3],
     pub fov_y: f32,
     pub width: u32,

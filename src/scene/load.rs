@@ -6,7 +6,7 @@ use super::file::{MaterialOverride, MeshSpec, SceneFile};
 use super::material::validate;
 use super::mtl::clean_mtl;
 use super::{Camera, Material, Scene, SceneError};
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -73,7 +73,7 @@ fn load_from(source: &Source, toml_path: &Path, name: &str) -> Result<Scene, Sce
     let file =
         SceneFile::parse(&text).map_err(|message| SceneError::Toml { path: toml_path.to_path_buf(), message })?;
     let c = &file.camera;
-    let camera = Camera {
+    let camera = WorldCamera {
         eye: c.eye.into(),
         target: c.target.into(),
         up: c.up.into(),
@@ -81,7 +81,10 @@ fn load_from(source: &Source, toml_path: &Path, name: &str) -> Result<Scene, Sce
         width: c.width,
         height: c.height,
     };
-    camera.validate().map_err(|e| SceneError::Toml { path: toml_path.to_path_buf(), message: e.to_string() })?;
+    camera
+        .local(camera.target)
+        .validate()
+        .map_err(|e| SceneError::Toml { path: toml_path.to_path_buf(), message: e.to_string() })?;
     let mut meshes = Meshes::default();
     for spec in &file.mesh {
         meshes.load(source, spec, toml_path)?;
@@ -89,10 +92,35 @@ fn load_from(source: &Source, toml_path: &Path, name: &str) -> Result<Scene, Sce
     meshes.into_scene(name.to_string(), camera, toml_path)
 }
 
+/// A camera in the coordinates of the scene's files (f64, as they may be far from the origin).
+struct WorldCamera {
+    eye: DVec3,
+    target: DVec3,
+    up: Vec3,
+    fov_y: f32,
+    width: u32,
+    height: u32,
+}
+
+impl WorldCamera {
+    /// The camera relative to `origin`, in f32.
+    fn local(&self, origin: DVec3) -> Camera {
+        Camera {
+            eye: (self.eye - origin).as_vec3(),
+            target: (self.target - origin).as_vec3(),
+            up: self.up,
+            fov_y: self.fov_y,
+            width: self.width,
+            height: self.height,
+        }
+    }
+}
+
 /// Triangles and materials gathered from the meshes of one scene.
 #[derive(Default)]
 struct Meshes {
-    positions: Vec<[Vec3; 3]>,
+    /// In the files' coordinates, f64: rebased and rounded to f32 once every mesh is in.
+    positions: Vec<[DVec3; 3]>,
     material_ids: Vec<u32>,
     materials: Vec<Material>,
     names: Vec<String>,
@@ -202,7 +230,7 @@ impl Meshes {
             };
             let vertex = |i: u32| {
                 let i = 3 * i as usize;
-                Vec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
+                DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
             };
             for f in mesh.indices.chunks_exact(3) {
                 self.positions.push([vertex(f[0]), vertex(f[1]), vertex(f[2])]);
@@ -220,13 +248,25 @@ impl Meshes {
         })
     }
 
-    fn into_scene(self, name: String, camera: Camera, path: &Path) -> Result<Scene, SceneError> {
-        let mut scene = Scene::new(name, camera, &self.positions, &self.material_ids, self.materials, self.names)
-            .map_err(|e| match e {
-                SceneError::Invalid(message) => SceneError::Mesh { path: path.to_path_buf(), message },
-                other => other,
-            })?;
+    /// Rebases a scene far from the origin (by more than 16 times its size) to its bounds' centre, in f64, then
+    /// rounds to f32: it then renders as it would at the origin (f32 positions 10⁵ m out are 8 mm apart).
+    fn into_scene(self, name: String, camera: WorldCamera, path: &Path) -> Result<Scene, SceneError> {
+        let (lo, hi) = self
+            .positions
+            .iter()
+            .flatten()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        let (centre, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+        let origin = if centre.is_finite() && centre.length() > 16.0 * radius.max(1e-3) { centre } else { DVec3::ZERO };
+        let positions: Vec<[Vec3; 3]> = self.positions.iter().map(|t| t.map(|v| (v - origin).as_vec3())).collect();
+        let mut scene =
+            Scene::new(name, camera.local(origin), &positions, &self.material_ids, self.materials, self.names)
+                .map_err(|e| match e {
+                    SceneError::Invalid(message) => SceneError::Mesh { path: path.to_path_buf(), message },
+                    other => other,
+                })?;
         scene.warnings.splice(0..0, self.warnings);
+        scene.origin = origin;
         Ok(scene)
     }
 }
@@ -234,27 +274,35 @@ impl Meshes {
 /// MTL → Phong: Kd → k_d, Ks → k_s, Ns → α, Ke → L_e; missing values are 0 (α: 1). Then the overrides.
 fn from_mtl(m: &tobj::Material, o: Option<&MaterialOverride>) -> Material {
     let o = o.cloned().unwrap_or_default();
+    let f32s = |c: [f64; 3]| c.map(|x| x as f32);
     let v = |x: Option<[f32; 3]>| x.map(Vec3::from).unwrap_or(Vec3::ZERO);
     Material {
-        kd: v(o.kd.or(m.diffuse)),
-        ks: v(o.ks.or(m.specular)),
-        alpha: o.alpha.or(m.shininess).unwrap_or(1.0),
-        emission: v(o.ke.or(m.emissive)),
+        kd: v(o.kd.or(m.diffuse.map(f32s))),
+        ks: v(o.ks.or(m.specular.map(f32s))),
+        alpha: o.alpha.or(m.shininess.map(|a| a as f32)).unwrap_or(1.0),
+        emission: v(o.ke.or(m.emissive.map(f32s))),
     }
 }
 
 /// A camera for a bare OBJ: looks at the bounding box's centre along −z from far enough to see all of it.
-fn auto_camera(positions: &[[Vec3; 3]]) -> Camera {
+fn auto_camera(positions: &[[DVec3; 3]]) -> WorldCamera {
     let (lo, hi) =
-        positions.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        positions.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
     let (centre, radius) = if lo.is_finite() && hi.is_finite() {
         (0.5 * (lo + hi), (0.5 * (hi - lo).length()).max(1e-3))
     } else {
-        (Vec3::ZERO, 1.0)
+        (DVec3::ZERO, 1.0)
     };
     let fov_y = 40.0f32;
-    let distance = radius / (0.5 * fov_y.to_radians()).sin();
-    Camera { eye: centre + Vec3::new(0.0, 0.0, distance), target: centre, up: Vec3::Y, fov_y, width: 512, height: 512 }
+    let distance = radius / (0.5 * fov_y as f64).to_radians().sin();
+    WorldCamera {
+        eye: centre + DVec3::new(0.0, 0.0, distance),
+        target: centre,
+        up: Vec3::Y,
+        fov_y,
+        width: 512,
+        height: 512,
+    }
 }
 
 /// The names an OBJ's `usemtl` lines use that none of its materials has, each once.

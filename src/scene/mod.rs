@@ -48,6 +48,9 @@ pub struct Scene {
     pub emitters: Vec<u32>,
     /// Things the user should know that do not stop rendering (no emitter, non-energy-conserving material, …).
     pub warnings: Vec<String>,
+    /// Where the scene's own origin is in the coordinates of its files: a scene far from the origin is rebased
+    /// to its bounds' centre before its positions are rounded to f32 (0 for a scene near the origin).
+    pub origin: glam::DVec3,
     accel: Accel,
     /// Per triangle, its convex emitter group (see `convex`), which the shadow rays towards it may skip.
     convex_groups: Vec<Option<u32>>,
@@ -123,6 +126,7 @@ impl Scene {
             material_names,
             emitters,
             warnings,
+            origin: glam::DVec3::ZERO,
             accel,
             convex_groups,
         })
