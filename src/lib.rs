@@ -18,6 +18,7 @@
 //! named `u` and live in [0, 1); a density names its measure (`pdf_area`, `pdf_solid_angle`).
 
 pub mod app;
+pub mod fuzz;
 pub mod math;
 pub mod measure;
 pub mod probe;

@@ -179,6 +179,52 @@ fn a_scene_whose_mtl_is_missing_loads_and_says_so() {
     assert!(h.query_by_label_contains("marble").is_some(), "the unknown material is on screen");
 }
 
+/// A file dropped on the window, as eframe hands it over.
+#[derive(Debug)]
+struct Dropped(std::path::PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
+#[test]
+fn a_dropped_scene_opens_joins_the_recent_files_and_a_dropped_text_file_is_an_error() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let obj = dir.path().join("dropped.obj");
+    let mtl = "newmtl l\nKe 1 1 1\n";
+    std::fs::write(dir.path().join("dropped.mtl"), mtl).expect("write");
+    std::fs::write(&obj, "mtllib dropped.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl l\nf 1 2 3\n").expect("write");
+    let mut v = viewer();
+    v.set_recent_file(dir.path().join("config/recent"));
+    let mut h = harness(v);
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.input_mut().dropped_files.push(Arc::new(Dropped(obj.clone())));
+    h.step();
+    step_until(&mut h, "loading to end", |v| !v.is_loading());
+    h.step();
+    assert_eq!(h.state().scene().name, "dropped");
+    assert_eq!(h.state().recent_files(), [obj.to_string_lossy()]);
+    let saved = std::fs::read_to_string(dir.path().join("config/recent")).expect("the list is saved");
+    assert_eq!(saved.trim(), obj.to_string_lossy());
+    // The recent list is on screen, and opens again from there.
+    choose_in_combo_box(&mut h, "open a recent file", &obj.to_string_lossy());
+    h.step();
+    step_until(&mut h, "loading to end", |v| !v.is_loading());
+    assert_eq!(h.state().scene().name, "dropped");
+    // Something that is neither a scene nor a reference: an error, and the scene stays.
+    h.input_mut().dropped_files.push(Arc::new(Dropped(dir.path().join("notes.txt"))));
+    h.step();
+    h.step();
+    assert!(h.state().error().is_some_and(|e| e.contains("notes.txt")), "{:?}", h.state().error());
+    assert_eq!(h.state().scene().name, "dropped");
+}
+
 #[test]
 fn choosing_a_bundled_scene_loads_it_in_the_background() {
     let mut h = harness(viewer());

@@ -122,5 +122,8 @@ fn reference_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         if ui.button("Load").clicked() && !v.reference_path.trim().is_empty() {
             v.load_reference(PathBuf::from(v.reference_path.trim()));
         }
+        if ui.add_enabled(v.dialog.is_none(), egui::Button::new("Browse…")).clicked() {
+            v.open_dialog(super::files::FileKind::Reference);
+        }
     });
 }

@@ -44,7 +44,25 @@ fn scene_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         if ui.button("Open").clicked() && !v.open_path.trim().is_empty() {
             v.open(v.open_path.trim().to_string());
         }
+        if ui.add_enabled(v.dialog.is_none(), egui::Button::new("Browse…")).clicked() {
+            v.open_dialog(super::files::FileKind::Scene);
+        }
     });
+    if !v.recent.entries.is_empty() {
+        let mut chosen = None;
+        egui::ComboBox::from_label("recent").selected_text("open a recent file").width(220.0).show_ui(ui, |ui| {
+            for path in &v.recent.entries {
+                if ui.selectable_label(false, path.as_str()).clicked() {
+                    chosen = Some(path.clone());
+                }
+            }
+        });
+        if let Some(path) = chosen {
+            v.open_path = path.clone();
+            v.open(path);
+        }
+    }
+    ui.small("or drop a .toml or .obj file on the window");
     if let Some(l) = &v.loading {
         ui.horizontal(|ui| {
             ui.spinner();

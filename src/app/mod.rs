@@ -4,6 +4,7 @@ mod compare;
 mod compare_mode;
 mod controls;
 mod convergence;
+mod files;
 mod loader;
 mod orbit;
 mod probe;
@@ -65,6 +66,9 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
             }
             if let Some(pixel) = options.probe {
                 viewer.set_probe_pixel(pixel);
+            }
+            if let Some(file) = files::RecentFiles::default_file() {
+                viewer.set_recent_file(file);
             }
             viewer.bind_repaint(cc.egui_ctx.clone());
             Ok(Box::new(viewer))

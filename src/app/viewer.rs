@@ -77,6 +77,10 @@ pub struct Viewer {
     ui_intervals: Vec<Duration>,
     /// The probe panel and its thread.
     pub(super) probe: super::probe::ProbeUi,
+    /// A native file dialog while it is open.
+    pub(super) dialog: Option<super::files::Dialog>,
+    /// Scene files opened before, newest first.
+    pub(super) recent: super::files::RecentFiles,
 }
 
 impl Viewer {
@@ -136,6 +140,8 @@ impl Viewer {
             last_ui_start: None,
             ui_intervals: Vec::new(),
             probe,
+            dialog: None,
+            recent: super::files::RecentFiles::default(),
         };
         viewer.note_restart();
         viewer
@@ -192,6 +198,7 @@ impl Viewer {
         if self.repaint.lock().is_ok_and(|c| c.is_none()) {
             self.bind_repaint(ui.ctx().clone());
         }
+        self.take_dropped_files(ui.ctx());
         self.poll_loading();
         self.take_frames();
         self.poll_probe(ui.ctx());
@@ -206,6 +213,15 @@ impl Viewer {
         super::shortcuts::help_window(self, ui);
         super::convergence::convergence_window(self, ui);
         super::probe::probe_window(self, ui);
+        if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
+            egui::Area::new(egui::Id::unique("drop-hint")).anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0]).show(
+                ui.ctx(),
+                |ui| {
+                    egui::Frame::popup(ui.style())
+                        .show(ui, |ui| ui.heading("Drop to open: a scene (.toml, .obj) or a reference (.exr)"))
+                },
+            );
+        }
         if self.loading.is_some() || self.frame.is_none() {
             ui.ctx().request_repaint_after(Duration::from_millis(30));
         }
@@ -378,6 +394,63 @@ impl Viewer {
     }
 
     /// Starts loading a bundled scene or a file in the background; the current scene stays until it succeeds.
+    /// Keeps the recent scene files in `file` (read now, written on every open); without it they last as long
+    /// as the window (the tests' viewers).
+    pub fn set_recent_file(&mut self, file: std::path::PathBuf) {
+        self.recent = super::files::RecentFiles::load(file);
+    }
+
+    /// The recent scene files, newest first.
+    pub fn recent_files(&self) -> &[String] {
+        &self.recent.entries
+    }
+
+    /// Opens a native file dialog for a scene or a reference; the choice arrives in a later frame.
+    pub(super) fn open_dialog(&mut self, kind: super::files::FileKind) {
+        let start_in = std::path::Path::new(self.open_path.trim()).parent().map(std::path::Path::to_path_buf);
+        let start_in = start_in.filter(|d| d.is_dir());
+        self.dialog = Some(super::files::Dialog::open(kind, start_in, notifier(&self.repaint)));
+    }
+
+    /// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads; anything else
+    /// is an error on screen.
+    fn take_dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
+        for file in dropped {
+            let path = file.path().to_path_buf();
+            self.open_file(super::files::FileKind::of(&path), path);
+        }
+        if let Some(dialog) = &self.dialog
+            && let Some(answer) = dialog.poll()
+        {
+            self.dialog = None;
+            match answer {
+                Ok((kind, Some(path))) => self.open_file(Some(kind), path),
+                Ok((_, None)) => {}
+                Err(e) => self.error = Some(e),
+            }
+        }
+    }
+
+    fn open_file(&mut self, kind: Option<super::files::FileKind>, path: std::path::PathBuf) {
+        use super::files::FileKind;
+        let text = path.to_string_lossy().into_owned();
+        match kind {
+            Some(FileKind::Scene) => {
+                self.open_path = text.clone();
+                self.open(text);
+            }
+            Some(FileKind::Reference) => {
+                self.reference_path = text;
+                self.load_reference(path);
+            }
+            None => {
+                self.error =
+                    Some(format!("cannot open {}: drop a scene (.toml or .obj) or a reference (.exr)", path.display()))
+            }
+        }
+    }
+
     pub(super) fn open(&mut self, what: String) {
         self.loading = Some(Loading::start(what, notifier(&self.repaint)));
         self.error = None;
@@ -385,9 +458,14 @@ impl Viewer {
 
     fn poll_loading(&mut self) {
         let Some(result) = self.loading.as_ref().and_then(Loading::poll) else { return };
-        self.loading = None;
+        let what = self.loading.take().map(|l| l.what).unwrap_or_default();
         match result {
             Ok(scene) => {
+                if std::path::Path::new(&what).is_file()
+                    && let Err(e) = self.recent.push(&what)
+                {
+                    self.error = Some(e);
+                }
                 self.home_camera = scene.camera;
                 self.camera = scene.camera;
                 self.selected_material = 0;

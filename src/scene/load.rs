@@ -15,6 +15,8 @@ use std::path::{Path, PathBuf};
 enum Source {
     Dir(PathBuf),
     Bundled(&'static BundledScene),
+    /// Files held in memory, by name (the fuzzer's input).
+    Memory(Vec<(PathBuf, String)>),
 }
 
 impl Source {
@@ -28,6 +30,13 @@ impl Source {
                 path: rel.to_path_buf(),
                 cause: std::io::Error::new(std::io::ErrorKind::NotFound, "not in the bundled scene"),
             }),
+            Source::Memory(files) => {
+                let rel = rel.strip_prefix(".").unwrap_or(rel);
+                files.iter().find(|(name, _)| name == rel).map(|(_, text)| text.clone()).ok_or_else(|| SceneError::Io {
+                    path: rel.to_path_buf(),
+                    cause: std::io::Error::new(std::io::ErrorKind::NotFound, "not among the files given"),
+                })
+            }
         }
     }
 }
@@ -50,6 +59,17 @@ pub fn load_scene(name_or_path: &str) -> Result<Scene, SceneError> {
         });
     }
     Err(SceneError::UnknownScene { name: name_or_path.to_string(), known: bundled::names().join(", ") })
+}
+
+/// Loads a scene from three texts that stand for `scene.toml`, `scene.obj` and `scene.mtl`, given one after
+/// the other, separated by NUL bytes (as the loader's fuzz target and its corpus replay feed it). Never panics:
+/// any input is a scene or an error.
+pub fn load_scene_from_bytes(data: &[u8]) -> Result<Scene, SceneError> {
+    let mut parts = data.splitn(3, |&b| b == 0).map(|p| String::from_utf8_lossy(p).into_owned());
+    let (toml, obj, mtl) =
+        (parts.next().unwrap_or_default(), parts.next().unwrap_or_default(), parts.next().unwrap_or_default());
+    let files = vec![("scene.toml".into(), toml), ("scene.obj".into(), obj), ("scene.mtl".into(), mtl)];
+    load_from(&Source::Memory(files), Path::new("scene.toml"), "fuzz")
 }
 
 /// Loads a scene file from disk (`.toml`, or `.obj` with an automatic camera).

@@ -20,7 +20,7 @@ pub use camera::{Camera, CameraBasis};
 pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection};
 pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
-pub use load::{load_scene, load_scene_file};
+pub use load::{load_scene, load_scene_file, load_scene_from_bytes};
 pub use material::Material;
 
 use glam::Vec3;

@@ -1,0 +1,135 @@
+//! Opening files the way desktop users expect: a native dialog (rfd; on Linux the XDG desktop portal) on its own
+//! thread, so that the image keeps refining while it is open; drag-and-drop of a scene (`.toml`, `.obj`) or a
+//! reference (`.exr`) onto the window; and a short list of recent scene files, kept in the user's config folder.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{Receiver, TryRecvError, channel};
+
+/// What a dialog or a dropped file is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    Scene,
+    Reference,
+}
+
+impl FileKind {
+    /// What a dropped file is, by its extension; `None` for anything else.
+    pub fn of(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "toml" | "obj" => Some(FileKind::Scene),
+            "exr" => Some(FileKind::Reference),
+            _ => None,
+        }
+    }
+}
+
+/// A native file dialog open on its own thread.
+pub struct Dialog {
+    kind: FileKind,
+    answer: Receiver<Option<PathBuf>>,
+}
+
+impl Dialog {
+    /// Opens the dialog; `notify` wakes the UI when it closes.
+    pub fn open(kind: FileKind, start_in: Option<PathBuf>, notify: impl Fn() + Send + 'static) -> Self {
+        let (tx, answer) = channel();
+        std::thread::spawn(move || {
+            let mut dialog = rfd::FileDialog::new();
+            dialog = match kind {
+                FileKind::Scene => dialog.set_title("Open a scene").add_filter("scene", &["toml", "obj"]),
+                FileKind::Reference => dialog.set_title("Load a reference").add_filter("OpenEXR", &["exr"]),
+            };
+            if let Some(dir) = start_in {
+                dialog = dialog.set_directory(dir);
+            }
+            let _ = tx.send(dialog.pick_file());
+            notify();
+        });
+        Self { kind, answer }
+    }
+
+    /// `None` while it is open; then what was picked (`Ok(None)`: cancelled). `Err` if the dialog could not
+    /// run at all (its thread ended without an answer).
+    pub fn poll(&self) -> Option<Result<(FileKind, Option<PathBuf>), String>> {
+        match self.answer.try_recv() {
+            Ok(path) => Some(Ok((self.kind, path))),
+            Err(TryRecvError::Empty) => None,
+            Err(TryRecvError::Disconnected) => {
+                Some(Err("the file dialog could not open: type the path, or drop the file on the window".into()))
+            }
+        }
+    }
+}
+
+/// The recent scene files, newest first, at most [`RecentFiles::MAX`]; saved in `file` if there is one.
+#[derive(Debug, Default)]
+pub struct RecentFiles {
+    pub entries: Vec<String>,
+    file: Option<PathBuf>,
+}
+
+impl RecentFiles {
+    pub const MAX: usize = 8;
+
+    /// `$XDG_CONFIG_HOME/illumlab/recent` (or `~/.config/illumlab/recent`).
+    pub fn default_file() -> Option<PathBuf> {
+        let config = std::env::var_os("XDG_CONFIG_HOME")
+            .map(PathBuf::from)
+            .filter(|p| p.is_absolute())
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+        Some(config.join("illumlab").join("recent"))
+    }
+
+    /// The list kept in `file` (one path per line; missing or unreadable: empty).
+    pub fn load(file: PathBuf) -> Self {
+        let text = std::fs::read_to_string(&file).unwrap_or_default();
+        let entries = text.lines().filter(|l| !l.trim().is_empty()).take(Self::MAX).map(str::to_owned).collect();
+        Self { entries, file: Some(file) }
+    }
+
+    /// Puts `path` first and saves the list; `Err` says why it could not be saved (the list still changes).
+    pub fn push(&mut self, path: &str) -> Result<(), String> {
+        self.entries.retain(|e| e != path);
+        self.entries.insert(0, path.to_owned());
+        self.entries.truncate(Self::MAX);
+        let Some(file) = &self.file else { return Ok(()) };
+        let save = || -> std::io::Result<()> {
+            if let Some(dir) = file.parent() {
+                std::fs::create_dir_all(dir)?;
+            }
+            std::fs::write(file, self.entries.join("\n") + "\n")
+        };
+        save().map_err(|e| format!("cannot save the recent files in {}: {e}", file.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recent_files_are_newest_first_unique_bounded_and_kept() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("sub/recent");
+        let mut recent = RecentFiles::load(file.clone());
+        assert!(recent.entries.is_empty());
+        for i in 0..10 {
+            recent.push(&format!("/scenes/{i}.toml")).unwrap();
+        }
+        recent.push("/scenes/3.toml").unwrap();
+        assert_eq!(recent.entries.len(), RecentFiles::MAX);
+        assert_eq!(recent.entries[0], "/scenes/3.toml");
+        assert_eq!(recent.entries[1], "/scenes/9.toml");
+        assert_eq!(RecentFiles::load(file).entries, recent.entries, "saved and read back");
+    }
+
+    #[test]
+    fn dropped_files_are_known_by_their_extension() {
+        assert_eq!(FileKind::of(Path::new("a/b.TOML")), Some(FileKind::Scene));
+        assert_eq!(FileKind::of(Path::new("b.obj")), Some(FileKind::Scene));
+        assert_eq!(FileKind::of(Path::new("r.exr")), Some(FileKind::Reference));
+        assert_eq!(FileKind::of(Path::new("notes.txt")), None);
+        assert_eq!(FileKind::of(Path::new("noext")), None);
+    }
+}
