@@ -533,6 +533,21 @@ fn strategies_lists_one_line_per_strategy() {
     }
 }
 
+#[test]
+fn a_reader_that_closes_the_pipe_early_is_not_an_error() {
+    // `illumlab strategies | head -0`: stdout is closed before illumlab writes.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_illumlab"))
+        .arg("strategies")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("cannot start illumlab");
+    drop(child.stdout.take());
+    let output = child.wait_with_output().expect("wait");
+    assert!(output.status.success(), "exit status {:?}", output.status);
+    assert!(!stderr(&output).contains("panicked"), "{}", stderr(&output));
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Determinism and the written image
 // ---------------------------------------------------------------------------------------------------------------
