@@ -3,6 +3,8 @@
 //! warning and a black image, `illumlab strategies` lists the strategies, and the image depends only on (scene,
 //! options, seed). Renders are tiny so that the whole file runs in a few seconds in the debug profile.
 
+mod common;
+
 use std::ffi::{OsStr, OsString};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -106,18 +108,7 @@ fn assert_render_fails(
 /// A small valid scene: a grey floor quad lit by a downward-facing square light above it. Each bad-scene test
 /// changes exactly one thing in it, so that the failure can only come from that change (the control test
 /// `test_scene_is_valid` renders it unchanged).
-const TOML: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-target = [0.0, 0.5, 0.0]
-up = [0.0, 1.0, 0.0]
-fov_y = 45.0
-width = 8
-height = 8
-
-[[mesh]]
-obj = "scene.obj"
-"#;
+use common::SMALL_SCENE_TOML as TOML;
 
 const OBJ: &str = "\
 mtllib scene.mtl

@@ -3,24 +3,15 @@
 //! unknown material is a warning and the default grey, not a failure; a malformed number still fails, naming the
 //! file, the line and the statement.
 
+mod common;
+
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
 use illumlab::scene::{Scene, load_scene_file};
 use std::fs;
 use std::sync::Arc;
 use tempfile::TempDir;
 
-const TOML: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-target = [0.0, 0.5, 0.0]
-up = [0.0, 1.0, 0.0]
-fov_y = 45.0
-width = 16
-height = 16
-
-[[mesh]]
-obj = "scene.obj"
-"#;
+use common::SMALL_SCENE_TOML as TOML;
 
 /// A glossy floor quad under a square light, in the clean form.
 const OBJ: &str = "\

@@ -49,6 +49,18 @@ fn choose_in_combo_box(h: &mut Harness<'_, Viewer>, current: &str, choice: &str)
     h.get_by_label(choice).click();
 }
 
+/// Types `path` into the scene panel's file field, presses Open and waits for the load to end.
+fn open_by_path(h: &mut Harness<'_, Viewer>, path: &std::path::Path) {
+    h.get_by_label("file").focus();
+    h.step();
+    h.get_by_label("file").type_text(&path.to_string_lossy());
+    h.step();
+    h.get_by_label("Open").click();
+    h.step();
+    step_until(h, "loading to end", |v| !v.is_loading());
+    h.step();
+}
+
 #[test]
 fn choosing_a_strategy_by_its_label_changes_the_render_and_restarts() {
     let mut h = harness(viewer());
@@ -139,14 +151,7 @@ fn a_broken_scene_file_shows_an_error_and_the_previous_scene_stays_usable() {
     std::fs::write(&broken, "[camera]\neye = [0, 1, 2\n").expect("write");
     let mut h = harness(viewer());
     step_until(&mut h, "a frame", |v| v.frame().is_some());
-    h.get_by_label("file").focus();
-    h.step();
-    h.get_by_label("file").type_text(&broken.to_string_lossy());
-    h.step();
-    h.get_by_label("Open").click();
-    h.step();
-    step_until(&mut h, "loading to end", |v| !v.is_loading());
-    h.step();
+    open_by_path(&mut h, &broken);
     let error = h.state().error().expect("an error").to_string();
     assert!(error.contains("broken.toml"), "{error}");
     assert!(h.query_by_label_contains("broken.toml").is_some(), "the error is on screen");
@@ -165,14 +170,7 @@ fn a_scene_whose_mtl_is_missing_loads_and_says_so() {
     std::fs::write(&obj, "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl marble\nf 1 2 3\n").expect("write");
     let mut h = harness(viewer());
     step_until(&mut h, "a frame", |v| v.frame().is_some());
-    h.get_by_label("file").focus();
-    h.step();
-    h.get_by_label("file").type_text(&obj.to_string_lossy());
-    h.step();
-    h.get_by_label("Open").click();
-    h.step();
-    step_until(&mut h, "loading to end", |v| !v.is_loading());
-    h.step();
+    open_by_path(&mut h, &obj);
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     assert_eq!(h.state().scene().name, "lonely");
     assert!(h.query_by_label_contains("no such MTL file").is_some(), "the missing MTL is on screen");

@@ -9,6 +9,21 @@ use illumlab::math::SampleRng;
 use illumlab::render::{RenderSettings, ShadingPoint, Strategy, estimate_direct};
 use illumlab::scene::{Camera, EmitterSampler, LightSelection, Material, Scene};
 
+/// The scene file of the small test scenes the command-line and loader tests write (`scene.obj` beside it):
+/// an 8×8 camera looking down at the floor.
+pub const SMALL_SCENE_TOML: &str = r#"
+[camera]
+eye = [0.0, 1.0, 3.0]
+target = [0.0, 0.5, 0.0]
+up = [0.0, 1.0, 0.0]
+fov_y = 45.0
+width = 8
+height = 8
+
+[[mesh]]
+obj = "scene.obj"
+"#;
+
 /// A camera that is never used to render: the estimators are evaluated at chosen shading points.
 pub fn any_camera() -> Camera {
     Camera { eye: Vec3::new(0.0, 1.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y: 40.0, width: 8, height: 8 }
