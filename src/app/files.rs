@@ -34,6 +34,11 @@ impl Dialog {
     /// Opens the dialog; `notify` wakes the UI when it closes.
     pub fn open(kind: FileKind, start_in: Option<PathBuf>, notify: impl Fn() + Send + 'static) -> Self {
         let (tx, answer) = channel();
+        // On Linux the dialog is the desktop portal's, reached over the session's D-Bus: without one there is no
+        // dialog, and rfd would answer as if it had been cancelled. Say so instead (the sender is dropped).
+        if cfg!(target_os = "linux") && std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_none() {
+            return Self { kind, answer };
+        }
         std::thread::spawn(move || {
             let mut dialog = rfd::FileDialog::new();
             dialog = match kind {
@@ -56,7 +61,9 @@ impl Dialog {
             Ok(path) => Some(Ok((self.kind, path))),
             Err(TryRecvError::Empty) => None,
             Err(TryRecvError::Disconnected) => {
-                Some(Err("the file dialog could not open: type the path, or drop the file on the window".into()))
+                Some(Err("no file dialog here (it needs the desktop portal on a D-Bus session): type the path, or \
+                          drop the file on the window"
+                    .into()))
             }
         }
     }
