@@ -1,7 +1,9 @@
 //! Opening files the way desktop users expect: a native dialog (rfd; on Linux the XDG desktop portal) on its own
 //! thread, so that the image keeps refining while it is open; drag-and-drop of a scene (`.toml`, `.obj`) or a
 //! reference (`.exr`) onto the window; and a short list of recent scene files, kept in the user's config folder.
+//! The viewer's side of it (what a dropped or picked file opens) is at the end.
 
+use super::viewer::Viewer;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 
@@ -108,6 +110,64 @@ impl RecentFiles {
             std::fs::write(file, self.entries.join("\n") + "\n")
         };
         save().map_err(|e| format!("cannot save the recent files in {}: {e}", file.display()))
+    }
+}
+
+impl Viewer {
+    /// Keeps the recent scene files in `file` (read now, written on every open); without it they last as long
+    /// as the window (the tests' viewers).
+    pub fn set_recent_file(&mut self, file: std::path::PathBuf) {
+        self.recent = RecentFiles::load(file);
+    }
+
+    /// The recent scene files, newest first.
+    pub fn recent_files(&self) -> &[String] {
+        &self.recent.entries
+    }
+
+    /// Opens a native file dialog for a scene or a reference; the choice arrives in a later frame.
+    pub(super) fn open_dialog(&mut self, kind: FileKind) {
+        let start_in = std::path::Path::new(self.open_path.trim()).parent().map(std::path::Path::to_path_buf);
+        let start_in = start_in.filter(|d| d.is_dir());
+        self.dialog = Some(Dialog::open(kind, start_in, self.waker()));
+    }
+
+    /// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads; anything else
+    /// is an error on screen.
+    pub(super) fn take_dropped_files(&mut self, ctx: &egui::Context) {
+        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
+        for file in dropped {
+            let path = file.path().to_path_buf();
+            self.open_file(FileKind::of(&path), path);
+        }
+        if let Some(dialog) = &self.dialog
+            && let Some(answer) = dialog.poll()
+        {
+            self.dialog = None;
+            match answer {
+                Ok((kind, Some(path))) => self.open_file(Some(kind), path),
+                Ok((_, None)) => {}
+                Err(e) => self.error = Some(e),
+            }
+        }
+    }
+
+    fn open_file(&mut self, kind: Option<FileKind>, path: std::path::PathBuf) {
+        let text = path.to_string_lossy().into_owned();
+        match kind {
+            Some(FileKind::Scene) => {
+                self.open_path = text.clone();
+                self.open(text);
+            }
+            Some(FileKind::Reference) => {
+                self.reference_path = text;
+                self.load_reference(path);
+            }
+            None => {
+                self.error =
+                    Some(format!("cannot open {}: drop a scene (.toml or .obj) or a reference (.exr)", path.display()))
+            }
+        }
     }
 }
 

@@ -394,65 +394,13 @@ impl Viewer {
     }
 
     /// Starts loading a bundled scene or a file in the background; the current scene stays until it succeeds.
-    /// Keeps the recent scene files in `file` (read now, written on every open); without it they last as long
-    /// as the window (the tests' viewers).
-    pub fn set_recent_file(&mut self, file: std::path::PathBuf) {
-        self.recent = super::files::RecentFiles::load(file);
-    }
-
-    /// The recent scene files, newest first.
-    pub fn recent_files(&self) -> &[String] {
-        &self.recent.entries
-    }
-
-    /// Opens a native file dialog for a scene or a reference; the choice arrives in a later frame.
-    pub(super) fn open_dialog(&mut self, kind: super::files::FileKind) {
-        let start_in = std::path::Path::new(self.open_path.trim()).parent().map(std::path::Path::to_path_buf);
-        let start_in = start_in.filter(|d| d.is_dir());
-        self.dialog = Some(super::files::Dialog::open(kind, start_in, notifier(&self.repaint)));
-    }
-
-    /// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads; anything else
-    /// is an error on screen.
-    fn take_dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
-        for file in dropped {
-            let path = file.path().to_path_buf();
-            self.open_file(super::files::FileKind::of(&path), path);
-        }
-        if let Some(dialog) = &self.dialog
-            && let Some(answer) = dialog.poll()
-        {
-            self.dialog = None;
-            match answer {
-                Ok((kind, Some(path))) => self.open_file(Some(kind), path),
-                Ok((_, None)) => {}
-                Err(e) => self.error = Some(e),
-            }
-        }
-    }
-
-    fn open_file(&mut self, kind: Option<super::files::FileKind>, path: std::path::PathBuf) {
-        use super::files::FileKind;
-        let text = path.to_string_lossy().into_owned();
-        match kind {
-            Some(FileKind::Scene) => {
-                self.open_path = text.clone();
-                self.open(text);
-            }
-            Some(FileKind::Reference) => {
-                self.reference_path = text;
-                self.load_reference(path);
-            }
-            None => {
-                self.error =
-                    Some(format!("cannot open {}: drop a scene (.toml or .obj) or a reference (.exr)", path.display()))
-            }
-        }
+    /// Wakes the UI from another thread (a dialog's, a loader's).
+    pub(super) fn waker(&self) -> impl Fn() + Send + 'static {
+        notifier(&self.repaint)
     }
 
     pub(super) fn open(&mut self, what: String) {
-        self.loading = Some(Loading::start(what, notifier(&self.repaint)));
+        self.loading = Some(Loading::start(what, self.waker()));
         self.error = None;
     }
 

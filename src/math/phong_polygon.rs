@@ -25,28 +25,27 @@ pub fn phong_polygon_moment(p: DVec3, n: DVec3, w: DVec3, k: u32, vertices: &[DV
     let rel: Vec<DVec3> = vertices.iter().map(|v| *v - p).collect();
     let clipped = clip_to_half_space(&clip_to_half_space(&rel, n), w);
     let Some(poly) = spherical_polygon(&clipped) else { return 0.0 };
+    // Each edge's normal and its integrals J_0 ..= J_k, which both sums below read.
+    let edges: Vec<(DVec3, Vec<f64>)> =
+        edges(&poly).filter_map(|(a, b)| Edge::new(a, b)).map(|e| (e.normal, e.integrals(w, k))).collect();
     let k_f = k as f64;
-    let mut boundary = 0.0;
-    for (a, b) in edges(&poly) {
-        let Some(edge) = Edge::new(a, b) else { continue };
-        boundary += edge.normal.dot(n) * edge.integrals(w, k)[k as usize];
-    }
-    let axial = if k == 0 { 0.0 } else { axial_moment(&poly, w, k - 1) };
+    let boundary: f64 = edges.iter().map(|(normal, j)| normal.dot(n) * j[k as usize]).sum();
+    let axial = if k == 0 { 0.0 } else { axial_moment(solid_angle(&poly), &edges, w, k - 1) };
     let value = (k_f * w.dot(n) * axial - boundary) / (k_f + 2.0);
     value.max(0.0)
 }
 
-/// `τ_k = ∫_P (w·u)^k du` over a convex spherical polygon (unit vertices, edges' normals outward).
-fn axial_moment(poly: &[DVec3], w: DVec3, k: u32) -> f64 {
-    let omega = solid_angle(poly);
-    let mut boundary = 0.0;
-    for (a, b) in edges(poly) {
-        let Some(edge) = Edge::new(a, b) else { continue };
-        let j = edge.integrals(w, k.saturating_sub(1));
-        // i = k−1, k−3, … ≥ 0.
-        let sum: f64 = (0..k).rev().step_by(2).map(|i| j[i as usize]).sum();
-        boundary += edge.normal.dot(w) * sum;
-    }
+/// `τ_k = ∫_P (w·u)^k du` over a convex spherical polygon of solid angle Ω, from its edges' outward normals and
+/// integrals J_i (i ≤ k at least).
+fn axial_moment(omega: f64, edges: &[(DVec3, Vec<f64>)], w: DVec3, k: u32) -> f64 {
+    let boundary: f64 = edges
+        .iter()
+        .map(|(normal, j)| {
+            // i = k−1, k−3, … ≥ 0.
+            let sum: f64 = (0..k).rev().step_by(2).map(|i| j[i as usize]).sum();
+            normal.dot(w) * sum
+        })
+        .sum();
     let even = if k.is_multiple_of(2) { omega } else { 0.0 };
     (even - boundary) / (k as f64 + 1.0)
 }
