@@ -15,8 +15,8 @@
 use cpu_time::ThreadTime;
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group};
 use glam::Vec3;
-use illumlab::math::{SampleRng, Vec3x8, offset_ray_origin};
-use illumlab::render::{Film, RenderSettings, Renderer, SEGMENT_END, Strategy};
+use illumlab::math::{SampleRng, Vec3x8};
+use illumlab::render::{Film, RenderSettings, Renderer, SEGMENT_END, Strategy, shadow_ray_ends};
 use illumlab::sampling::sample_uniform_triangle;
 use illumlab::scene::{EmitterSampler, LightSelection, SKIP_NONE, Scene, load_scene};
 use std::hint::black_box;
@@ -64,8 +64,8 @@ fn workload(scene: &Scene) -> Workload {
             if !(light.n.dot(p - a) > 0.0 && light.n.dot(-wi) > 0.0 && n.dot(wi) > 0.0 && f != Vec3::ZERO) {
                 continue;
             }
-            let from = offset_ray_origin(p, n);
-            let d = offset_ray_origin(x, light.n) - from;
+            let (from, to) = shadow_ray_ends(scene, p, n, tri.error.at_point, (t, x, light.n));
+            let d = to - from;
             let l = lanes.2.count_ones() as usize;
             (lanes.0[l], lanes.1[l], lanes.2) = (from, d, lanes.2 | 1 << l);
             work.shadow.push((from, d));

@@ -26,8 +26,7 @@ const SAMPLES: u64 = 100_000;
 fn facing(v: [Vec3; 3]) -> Triangle {
     let n = (v[1] - v[0]).cross(v[2] - v[0]);
     let v = if n.dot(-v[0]) < 0.0 { [v[0], v[2], v[1]] } else { v };
-    let n = (v[1] - v[0]).cross(v[2] - v[0]);
-    Triangle { v, n: n.normalize(), area: 0.5 * n.length(), material: 1 }
+    Triangle::new(v, 1)
 }
 
 /// Edges from 0 to 1, refined geometrically (ratio 2, down to 10⁻⁷) on both sides of `peak`.

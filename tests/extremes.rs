@@ -4,9 +4,9 @@
 
 mod common;
 
-use common::{any_camera, estimate_with, quad};
+use common::{any_camera, estimate_with, on_surface, quad};
 use glam::Vec3;
-use illumlab::render::{Film, Heuristic, MisSettings, RenderSettings, Renderer, ShadingPoint, Strategy};
+use illumlab::render::{Film, Heuristic, MisSettings, RenderSettings, Renderer, Strategy};
 use illumlab::scene::{Camera, LightSelection, Material, Scene};
 
 const ALPHAS: [f32; 5] = [0.0, 1e-3, 1.0, 1e3, 1e6];
@@ -96,7 +96,7 @@ fn every_strategy_is_finite_at_the_extremes() {
         // The floor's normal is +y; at the light the geometric normal is −y.
         let n = if p.y >= 1.0 - 1e-3 { -Vec3::Y } else { Vec3::Y };
         for m in &materials {
-            let sp = ShadingPoint::new(p, n, wo, m);
+            let sp = on_surface(&scene, p, n, wo, m);
             for settings in all_settings() {
                 let e = estimate_with(&scene, &sp, &settings, 64);
                 assert_eq!(e.non_finite, 0, "{label}, α = {}, {settings:?}: non-finite samples", m.alpha);
@@ -175,7 +175,7 @@ fn the_probe_is_finite_at_the_extremes() {
     let materials: Vec<Material> = materials().into_iter().filter(|m| m.kd == m.ks || m.kd.x == 0.0).collect();
     for (p, n, wo) in points {
         for m in &materials {
-            let sp = ShadingPoint::new(p, n, wo, m);
+            let sp = on_surface(&scene, p, n, wo, m);
             let q = quadrature(&scene, &sp, 20_000);
             assert!(
                 q.value.is_finite() && q.value.min_element() >= 0.0,

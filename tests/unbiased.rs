@@ -7,10 +7,10 @@
 
 mod common;
 
-use common::{any_camera, estimate_with};
+use common::{any_camera, estimate_with, on_surface};
 use glam::{DVec3, Vec3};
 use illumlab::math::lambert_polygon_irradiance;
-use illumlab::render::{Heuristic, MisSettings, RenderSettings, ShadingPoint, Strategy};
+use illumlab::render::{Heuristic, MisSettings, RenderSettings, Strategy};
 use illumlab::scene::{LightSelection, Material, Scene};
 use std::f64::consts::PI;
 
@@ -87,7 +87,7 @@ fn check_with(settings: RenderSettings, samples: u64, far_samples: u64) {
     ];
     for (i, (label, p)) in points.into_iter().enumerate() {
         let material = &s.scene.materials[0];
-        let sp = ShadingPoint::new(p, Vec3::Y, wo, material);
+        let sp = on_surface(&s.scene, p, Vec3::Y, wo, material);
         let n = if i == 2 { far_samples } else { samples };
         let est = estimate_with(&s.scene, &sp, &RenderSettings { seed: 100 + i as u64, ..settings }, n);
         let expected = closed_form(&s, p.as_dvec3());
@@ -200,7 +200,7 @@ fn projected_solid_angle_has_zero_variance_under_one_triangle() {
             .expect("valid scene");
     let poly: Vec<DVec3> = tri.iter().map(|v| v.as_dvec3()).collect();
     for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.8, 0.0, 0.5), Vec3::new(3.0, 0.0, -2.0)] {
-        let sp = ShadingPoint::new(p, Vec3::Y, Vec3::new(0.1, 1.0, 0.2).normalize(), &scene.materials[0]);
+        let sp = on_surface(&scene, p, Vec3::Y, Vec3::new(0.1, 1.0, 0.2).normalize(), &scene.materials[0]);
         let settings = RenderSettings { strategy: Strategy::ProjectedSolidAngle, ..Default::default() };
         let est = estimate_with(&scene, &sp, &settings, 20_000);
         let expected = l.as_dvec3() * (0.5 / PI) * lambert_polygon_irradiance(p.as_dvec3(), DVec3::Y, &poly, 1.0);

@@ -12,10 +12,10 @@
 
 mod common;
 
-use common::{any_camera, estimate_with};
+use common::{any_camera, estimate_with, on_surface};
 use glam::{DVec3, Vec3};
 use illumlab::math::{lambert_polygon_irradiance, phong_polygon_moment, reflect};
-use illumlab::render::{MisSettings, RenderSettings, ShadingPoint, Strategy};
+use illumlab::render::{MisSettings, RenderSettings, Strategy};
 use illumlab::scene::{LightSelection, Material, Scene};
 use std::f64::consts::PI;
 
@@ -95,7 +95,7 @@ fn check(alpha: f32) {
     for (i, (label, p, aim)) in points.into_iter().enumerate() {
         let wr = (aim - p).normalize();
         let wo = reflect(wr, Vec3::Y);
-        let sp = ShadingPoint::new(p, Vec3::Y, wo, &m);
+        let sp = on_surface(&scene, p, Vec3::Y, wo, &m);
         let expected = closed_form(&m, p, wo);
         for settings in settings() {
             let hemisphere = !settings.strategy.samples_lights() && settings.strategy != Strategy::Mis;

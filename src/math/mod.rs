@@ -11,7 +11,7 @@ mod vec3x8;
 
 pub use equal_area::{SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk};
 pub use frame::Frame;
-pub use offset::{offset_ray_origin, offset_ray_origins};
+pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};
 pub use phong_polygon::phong_polygon_moment;
 pub use polygon::lambert_polygon_irradiance;
 pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes};

@@ -30,7 +30,7 @@ impl ProbePoint {
         let hit = scene.accel().closest_hit(basis.eye(), dir, f32::INFINITY)?;
         let tri = &scene.triangles[hit.triangle as usize];
         let material = &scene.materials[tri.material as usize];
-        let sp = ShadingPoint::new(scene.hit_point(&hit), tri.n, -dir, material);
+        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, -dir, material);
         Some(Self {
             pixel: (x, y),
             position: sp.p,
@@ -47,6 +47,7 @@ impl ProbePoint {
             n: self.normal,
             wo: self.wo,
             material: &scene.materials[self.material as usize],
+            error: scene.triangles[self.triangle as usize].error.at_point,
         }
     }
 }

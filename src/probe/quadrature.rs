@@ -71,7 +71,7 @@ fn integrate_light(scene: &Scene, sp: &ShadingPoint, t: u32, occlusion: bool, r:
         if fr == Vec3::ZERO || le == Vec3::ZERO {
             return DVec3::ZERO;
         }
-        if occlusion && !visible(scene, sp.p, sp.n, (t, x.as_vec3(), tri.n), &mut rays) {
+        if occlusion && !visible(scene, sp, (t, x.as_vec3(), tri.n), &mut rays) {
             return DVec3::ZERO;
         }
         (fr * le).as_dvec3() * (cos * cos_light / r2)

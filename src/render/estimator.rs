@@ -4,7 +4,7 @@
 use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
-use crate::math::{SampleRng, Vec3x8, offset_ray_origin, offset_ray_origins};
+use crate::math::{SampleRng, SurfaceError, Vec3x8, offset_ray_origin, offset_ray_origins};
 use crate::scene::{EmitterSampler, SKIP_NONE, Scene};
 use glam::Vec3;
 use wide::{CmpGt, f32x8};
@@ -61,7 +61,7 @@ pub(crate) fn integrand(
         Target::Trace => {
             let (f, cos) = brdf_and_cos(sp, s)?;
             *rays += 1;
-            let origin = offset_ray_origin(sp.p, sp.n);
+            let origin = offset_ray_origin(sp.p, sp.n, sp.error);
             let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY).ok_or(Outcome::MissedLights)?;
             let li = scene.emitted(hit.triangle, -s.wi);
             if li == Vec3::ZERO {
@@ -71,7 +71,7 @@ pub(crate) fn integrand(
         }
         Target::Emitter { triangle, point } => {
             let (value, n_x) = unshadowed(scene, sp, s, triangle)?;
-            if !visible(scene, sp.p, sp.n, (triangle, point, n_x), rays) {
+            if !visible(scene, sp, (triangle, point, n_x), rays) {
                 return Err(Outcome::Occluded);
             }
             Ok((value, Reached { triangle, point }))
@@ -82,7 +82,7 @@ pub(crate) fn integrand(
 /// The emitter triangle the ray from `sp` along `wi` reaches first, and where; `None` where it meets a surface
 /// that does not emit towards it, or nothing.
 pub fn reached(scene: &Scene, sp: &ShadingPoint, wi: Vec3) -> Option<Reached> {
-    let hit = scene.accel().closest_hit(offset_ray_origin(sp.p, sp.n), wi, f32::INFINITY)?;
+    let hit = scene.accel().closest_hit(offset_ray_origin(sp.p, sp.n, sp.error), wi, f32::INFINITY)?;
     (scene.emitted(hit.triangle, -wi) != Vec3::ZERO)
         .then(|| Reached { triangle: hit.triangle, point: scene.hit_point(&hit) })
 }
@@ -116,31 +116,56 @@ pub(super) fn unshadowed(
     Ok((f * le * cos, scene.triangles[triangle as usize].n))
 }
 
-/// Shadow ray between p (normal n, on the side of x) and the point x on the emitter triangle Δ (normal n_x,
-/// facing p), given as (Δ, x, n_x): both ends are moved off their surfaces (Ray Tracing Gems ch. 6), so neither
-/// triangle occludes itself. From in front of Δ's plane, the ray skips the rest of Δ's convex emitter group,
-/// which it cannot meet (`scene::convex`).
+/// Shadow ray between the shading point p (normal n, on the side of x) and the point x on the emitter triangle Δ
+/// (normal n_x, facing p), given as (Δ, x, n_x): both ends are moved off their surfaces by the bounds of their
+/// rounding errors (`math::offset`), so neither triangle occludes itself. From in front of Δ's plane, the ray
+/// skips the rest of Δ's convex emitter group, which it cannot meet (`scene::convex`).
 #[inline]
-pub fn visible(scene: &Scene, p: Vec3, n: Vec3, (triangle, x, n_x): (u32, Vec3, Vec3), rays: &mut u64) -> bool {
+pub fn visible(scene: &Scene, sp: &ShadingPoint, (triangle, x, n_x): (u32, Vec3, Vec3), rays: &mut u64) -> bool {
     *rays += 1;
-    let from = offset_ray_origin(p, n);
-    let to = offset_ray_origin(x, n_x);
+    let (from, to) = shadow_ray_ends(scene, sp.p, sp.n, sp.error, (triangle, x, n_x));
     let skip = if n_x.dot(from - x) > 0.0 { scene.convex_group(triangle) } else { None };
     !scene.accel().occluded(from, to - from, SEGMENT_END, skip)
 }
 
-/// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i), lane i's
-/// point x on a triangle of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible
-/// ones. Lane i's answer is `visible`'s, bit for bit.
+/// The ends of the shadow ray from p (normal n, off its surface by at most `error`) to x on Δ (normal n_x), each
+/// moved off its surface by its bound.
 #[inline]
-#[allow(clippy::too_many_arguments)]
+pub fn shadow_ray_ends(
+    scene: &Scene,
+    p: Vec3,
+    n: Vec3,
+    error: f32,
+    (triangle, x, n_x): (u32, Vec3, Vec3),
+) -> (Vec3, Vec3) {
+    let far = scene.triangles[triangle as usize].error.far_end(p, x, n_x);
+    (offset_ray_origin(p, n, error), offset_ray_origin(x, n_x, far))
+}
+
+/// The ends of eight shadow rays: [`shadow_ray_ends`] per lane, bit for bit, with lane l's far end on a triangle
+/// with bounds `far[l]`.
+#[inline]
+pub(super) fn shadow_ray_ends_lanes(
+    (p, n, error): (Vec3x8, Vec3x8, f32x8),
+    (x, n_x): (Vec3x8, Vec3x8),
+    far: &[SurfaceError; 8],
+) -> (Vec3x8, Vec3x8) {
+    let at_point = f32x8::new(far.map(|e| e.at_point));
+    let per_distance = Vec3x8::from_lanes(&far.map(|e| e.per_distance));
+    let far = SurfaceError::far_end_lanes(at_point, per_distance, p, x, n_x);
+    (offset_ray_origins(p, n, error), offset_ray_origins(x, n_x, far))
+}
+
+/// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i): the
+/// shading points (p, n, their bounds), the points x on the lights with their normals, lane i's x on a triangle
+/// with bounds `far[i]` of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible ones.
+/// Lane i's answer is `visible`'s, bit for bit.
+#[inline]
 pub(super) fn visible_lanes(
     scene: &Scene,
-    p: Vec3x8,
-    n: Vec3x8,
-    x: Vec3x8,
-    n_x: Vec3x8,
-    groups: [u32; 8],
+    near: (Vec3x8, Vec3x8, f32x8),
+    (x, n_x): (Vec3x8, Vec3x8),
+    (far, groups): (&[SurfaceError; 8], [u32; 8]),
     active: u32,
     rays: &mut u64,
 ) -> u32 {
@@ -148,8 +173,7 @@ pub(super) fn visible_lanes(
         return 0; // a group whose samples all missed, saw only a light, or were rejected
     }
     *rays += active.count_ones() as u64;
-    let from = offset_ray_origins(p, n);
-    let to = offset_ray_origins(x, n_x);
+    let (from, to) = shadow_ray_ends_lanes(near, (x, n_x), far);
     let mut skips = [SKIP_NONE; 8];
     if groups != skips {
         let in_front = n_x.dot(from - x).cmp_gt(f32x8::ZERO).move_mask();
@@ -164,6 +188,7 @@ pub const SEGMENT_END: f32 = 1.0 - 1e-6;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::gamma;
     use crate::sampling::sample_uniform_triangle;
     use crate::scene::load_scene;
 
@@ -195,7 +220,8 @@ mod tests {
                 x + (d + tri.n).normalize() * 10f32.powf(-4.0 + 3.0 * rng.uniform())
             };
             let n = (x - p).normalize();
-            let (from, to) = (offset_ray_origin(p, n), offset_ray_origin(x, tri.n));
+            let error = gamma(8) * p.abs().dot(n.abs());
+            let (from, to) = shadow_ray_ends(&scene, p, n, error, (light, x, tri.n));
             if !(tri.n.dot(from - x) > 0.0) {
                 continue;
             }

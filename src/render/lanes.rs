@@ -9,7 +9,7 @@
 use super::estimator::{unshadowed, visible_lanes};
 use super::strategy::{SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SampleRngLanes, Vec3x8, for_each_lane};
+use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
 use wide::{CmpGt, CmpLt, f32x8};
@@ -41,10 +41,10 @@ pub fn estimate_emitter_lanes(
         let tri = &scene.triangles[hits.triangle[l] as usize];
         let (c, n) = (tri.v[2], tri.n);
         rows[0][l] = Vec3x8::triangle_row(tri.v);
-        rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, 0.0, 0.0, 0.0, 0.0]);
+        rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, tri.error.at_point, 0.0, 0.0, 0.0]);
         materials[l] = tri.material;
     });
-    let [cz, nx, ny, nz, _, _, _, _] = f32x8::transpose(rows[1]);
+    let [cz, nx, ny, nz, p_error, _, _, _] = f32x8::transpose(rows[1]);
     let [a, b, c] = Vec3x8::triangles(rows[0], cz);
     let (u, v) = (hits.u, hits.v);
     let p = a + (b - a) * u + (c - a) * v;
@@ -59,18 +59,20 @@ pub fn estimate_emitter_lanes(
     // The records are read once every lane has picked, so that their loads wait on the alias table together.
     let none = EmitterTriangle::NONE.rows();
     let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
+    let mut light_error = [EmitterTriangle::NONE.error; LANES];
     // Every lane draws the light's uniform and the point's two, used or not: whether p faces Δ is tested for all
     // lanes below (`faces`), and a lane that does not, or that picked no light, or missed, reads none of them
     // after the one-sample estimator would have stopped.
     let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
     let mut picked_lanes = 0;
     if let Some(records) = emitters.pick_fixed_lanes(u_light) {
-        for_each_lane(hit_lanes, |l| [lo[l], hi[l]] = records[l].rows());
+        for_each_lane(hit_lanes, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
         picked_lanes = hit_lanes;
     } else {
         for_each_lane(hit_lanes, |l| {
             if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
-                [lo[l], hi[l]] = EmitterTriangle::of(scene, t, p_delta).rows();
+                let record = EmitterTriangle::of(scene, t, p_delta);
+                ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
                 picked_lanes |= 1 << l;
             }
         });
@@ -119,7 +121,7 @@ pub fn estimate_emitter_lanes(
             shadow_rays |= 1 << l;
         }
     });
-    let visible = visible_lanes(scene, p, n, x, ln, light_group, shadow_rays, rays);
+    let visible = visible_lanes(scene, (p, n, p_error), (x, ln), (&light_error, light_group), shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
 
@@ -137,25 +139,29 @@ pub fn estimate_light_lanes(
 ) -> [Vec3; LANES] {
     let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal.
+    // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal,
+    // and their bounds.
     let mut ends = [[Vec3::ZERO; LANES]; 4];
+    let (mut p_error, mut light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
     let mut groups = [SKIP_NONE; LANES];
     let mut shadow_rays = 0;
     for l in 0..LANES {
         let Some(hit) = hits.lane(l) else { continue };
         let tri = &scene.triangles[hit.triangle as usize];
         let wo = -dirs.lane(l);
-        let sp = ShadingPoint::new(scene.hit_point(&hit), tri.n, wo, scene.material_of(hit.triangle));
+        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
         emitted[l] = scene.emitted(hit.triangle, wo);
         let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
         let Target::Emitter { triangle, point } = s.target else { continue };
         let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
         reflected[l] = value / s.pdf;
         (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
+        (p_error[l], light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
         groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
         shadow_rays |= 1 << l;
     }
     let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
-    let visible = visible_lanes(scene, p, n, x, n_x, groups, shadow_rays, rays);
+    let near = (p, n, f32x8::new(p_error));
+    let visible = visible_lanes(scene, near, (x, n_x), (&light_error, groups), shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }

@@ -260,7 +260,7 @@ impl Renderer {
         let p = self.scene.hit_point(hit);
         let wo = -dir;
         let material = &self.scene.materials[tri.material as usize];
-        let sp = ShadingPoint::new(p, tri.n, wo, material);
+        let sp = ShadingPoint::on_triangle(p, tri, wo, material);
         let emitted = self.scene.emitted(hit.triangle, wo);
         emitted + self.settings.strategy.estimate(&self.context(), &sp, rng, rays, &mut ())
     }

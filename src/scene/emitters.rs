@@ -1,7 +1,7 @@
 //! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
 use super::{SKIP_NONE, Scene};
-use crate::math::{Vec3x8, luminance};
+use crate::math::{SurfaceError, Vec3x8, luminance};
 use crate::sampling::DiscreteDistribution;
 use glam::Vec3;
 use wide::f32x8;
@@ -54,9 +54,10 @@ pub struct EmitterSampler {
     records: Vec<EmitterTriangle>,
 }
 
-/// An emitter triangle as light sampling reads it, in one cache line with its p_Δ: picking one costs one load
-/// after the alias table's, where going through the slot's triangle index and the scene's triangle list costs
-/// two more, each waiting on the one before.
+/// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
+/// holds what sampling reads, the second the offset bounds the shadow ray reads later): picking one costs one
+/// load after the alias table's, where going through the slot's triangle index and the scene's triangle list
+/// costs two more, each waiting on the one before.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct EmitterTriangle {
@@ -69,6 +70,8 @@ pub struct EmitterTriangle {
     pub material: u32,
     /// [`Scene::convex_group`] of the triangle, or [`SKIP_NONE`] (an `Option` would not fit the cache line).
     pub convex_group: u32,
+    /// The triangle's [`Triangle::error`](super::Triangle::error), for the shadow ray's far end.
+    pub error: SurfaceError,
 }
 
 impl EmitterTriangle {
@@ -80,6 +83,7 @@ impl EmitterTriangle {
         p_delta: 0.0,
         material: u32::MAX,
         convex_group: SKIP_NONE,
+        error: SurfaceError { at_point: 0.0, per_distance: Vec3::ZERO },
     };
 
     /// The record of the scene's triangle `t`, picked with probability `p_delta`.
@@ -87,7 +91,7 @@ impl EmitterTriangle {
     pub fn of(scene: &Scene, t: u32, p_delta: f32) -> Self {
         let tri = &scene.triangles[t as usize];
         let convex_group = scene.convex_group(t).unwrap_or(SKIP_NONE);
-        Self { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material, convex_group }
+        Self { v: tri.v, n: tri.n, area: tri.area, p_delta, material: tri.material, convex_group, error: tri.error }
     }
 
     /// The record as two rows of eight, in field order (`v₀ v₁ v₂.xy`, then `v₂.z n_Δ A_Δ p_Δ material group`,

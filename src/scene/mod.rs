@@ -1,7 +1,7 @@
 //! Scenes: triangles with Phong materials, emissive triangles as area lights, a pinhole camera and a BVH.
 //! Loaded from a TOML scene file that lists OBJ/MTL meshes, or built directly (tests, analytic scenes).
 
-mod accel;
+pub(crate) mod accel;
 mod bundled;
 mod camera;
 mod convex;
@@ -23,6 +23,7 @@ pub use file::{MaterialOverride, SceneFile};
 pub use load::{load_scene, load_scene_file, load_scene_from_bytes};
 pub use material::Material;
 
+use crate::math::SurfaceError;
 use glam::Vec3;
 
 /// A triangle with its unit geometric normal `n = normalize((v₁−v₀)×(v₂−v₀))` (counter-clockwise winding) and
@@ -33,6 +34,18 @@ pub struct Triangle {
     pub n: Vec3,
     pub area: f32,
     pub material: u32,
+    /// How far computed points on it may be off its plane, for offsetting rays that leave it or end on it.
+    pub error: SurfaceError,
+}
+
+impl Triangle {
+    /// The triangle with vertices `v` (of non-zero area) and material `material`.
+    pub fn new(v: [Vec3; 3], material: u32) -> Self {
+        let cross = (v[1] - v[0]).cross(v[2] - v[0]);
+        let len = cross.length();
+        let n = cross / len;
+        Self { v, n, area: 0.5 * len, material, error: SurfaceError::of_triangle(v, n) }
+    }
 }
 
 /// A loaded scene, ready to render.
@@ -103,15 +116,8 @@ impl Scene {
         // Only groups that some subtree holds apart spare a shadow ray any work.
         let apart = accel.groups_held_apart();
         let convex_groups = order.iter().map(|&i| groups[i as usize].filter(|g| apart.contains(g))).collect();
-        let triangles: Vec<Triangle> = order
-            .iter()
-            .map(|&i| {
-                let v = kept[i as usize];
-                let cross = (v[1] - v[0]).cross(v[2] - v[0]);
-                let len = cross.length();
-                Triangle { v, n: cross / len, area: 0.5 * len, material: kept_ids[i as usize] }
-            })
-            .collect();
+        let triangles: Vec<Triangle> =
+            order.iter().map(|&i| Triangle::new(kept[i as usize], kept_ids[i as usize])).collect();
         let emitters: Vec<u32> = (0..triangles.len() as u32)
             .filter(|&i| materials[triangles[i as usize].material as usize].is_emissive())
             .collect();

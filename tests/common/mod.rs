@@ -77,6 +77,23 @@ pub struct Estimate {
     pub non_finite: u64,
 }
 
+/// The shading point where a ray towards p along −n meets the scene within 10⁻⁶ (1 + |p|) of p, as a camera
+/// ray's hit: the point from the triangle's barycentrics, with the triangle's error bound. Where there is no such
+/// triangle, [`ShadingPoint::new`] at p.
+pub fn on_surface<'a>(scene: &Scene, p: Vec3, n: Vec3, wo: Vec3, material: &'a Material) -> ShadingPoint<'a> {
+    let h = 1e-6 * (1.0 + p.abs().max_element());
+    match scene.accel().closest_hit(p + n * h, -n, 2.0 * h) {
+        Some(hit) => {
+            let tri = &scene.triangles[hit.triangle as usize];
+            ShadingPoint {
+                n: ShadingPoint::new(p, n, wo, material).n,
+                ..ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, material)
+            }
+        }
+        None => ShadingPoint::new(p, n, wo, material),
+    }
+}
+
 pub fn estimate_at(
     scene: &Scene,
     sp: &ShadingPoint,

@@ -17,6 +17,12 @@ use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;
 use wide::f32x8;
 
+/// The renderer's intersection test of one ray with one triangle: the distance of a hit at `0 < t`, if any.
+#[cfg(test)]
+pub(crate) fn test_ray_triangle(triangle: [Vec3; 3], origin: Vec3, dir: Vec3) -> Option<f32> {
+    TrianglePacket::new(&[(triangle, 0)]).closest(&ray::WideRay::new(origin, dir), f32::INFINITY).map(|h| h.t)
+}
+
 /// Acceleration structure over the scene's triangles, stored in the BVH's leaf order so that a hit's triangle
 /// index is the position in that order.
 #[derive(Clone)]
