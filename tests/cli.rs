@@ -675,7 +675,9 @@ fn bench_writes_csv_markdown_plot_and_reference_deterministically() {
     assert_eq!(rows.len(), 4, "two strategies × two budgets");
     let md = fs::read_to_string(out.join("bench.md")).expect("bench.md");
     assert!(md.contains("| cosine | 4 |") && md.contains("| emitter | 1 |"), "{md}");
-    assert!(md.contains("Machine:") && md.contains("Most efficient at 4 spp"), "{md}");
+    assert!(md.contains("Machine:") && md.contains("By MSE at 4 spp") && md.contains("By relMSE at 4 spp"), "{md}");
+    assert!(md.contains("Measured with fixed primary hits") && md.contains("means over 8 seed(s)"), "{md}");
+    assert!(md.contains("pixels (those that see an emitter) left out"), "{md}");
     assert_eq!(image::image_dimensions(out.join("convergence.png")).expect("png").0, 1200);
 
     // With the saved reference: no new reference, the same errors (only timings differ).
@@ -685,6 +687,12 @@ fn bench_writes_csv_markdown_plot_and_reference_deterministically() {
     assert_success(&second);
     assert!(!stdout(&second).contains("reference: MIS"));
     assert_eq!(csv_rmse(&again.join("bench.csv")), rows);
+
+    // The pictures' footprint, when asked for, and said.
+    let jittered = dir.path().join("b3");
+    assert_success(&run(bench_args(&jittered, &["--footprint", "jittered", "--seeds", "2"])));
+    let md = fs::read_to_string(jittered.join("bench.md")).expect("bench.md");
+    assert!(md.contains("Measured with jittered pixel footprint") && md.contains("means over 2 seed(s)"), "{md}");
 }
 
 #[test]
@@ -693,6 +701,8 @@ fn bench_bad_input_is_one_line() {
     let out = dir.path().join("b");
     let o = run(bench_args(&out, &["--strategies", "nope"]));
     assert_one_line_error(&o, &["--strategies"]);
+    assert_one_line_error(&run(bench_args(&out, &["--footprint", "nope"])), &["--footprint"]);
+    assert_one_line_error(&run(bench_args(&out, &["--seeds", "0"])), &["--seeds"]);
     let mut zero = bench_args(&out, &[]);
     let at = zero.iter().position(|a| a == "1,4").expect("spp");
     zero[at] = "0,4".into();

@@ -67,7 +67,13 @@ fn all_settings() -> Vec<RenderSettings> {
         for light in Strategy::ALL.into_iter().filter(|s| s.samples_lights()) {
             for heuristic in Heuristic::ALL {
                 let mis = MisSettings { techniques: [light, Strategy::Brdf], heuristic, samples: [2, 1] };
-                out.push(RenderSettings { strategy: Strategy::Mis, light_selection: selection, seed: 5, mis });
+                out.push(RenderSettings {
+                    strategy: Strategy::Mis,
+                    light_selection: selection,
+                    seed: 5,
+                    mis,
+                    ..Default::default()
+                });
             }
         }
     }

@@ -5,7 +5,7 @@ use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use illumlab::app::Viewer;
-use illumlab::render::{Film, Heuristic, Renderer, Strategy};
+use illumlab::render::{Film, Footprint, Heuristic, Renderer, Strategy};
 use illumlab::scene::load_scene;
 use illumlab::session::views::View;
 use std::sync::Arc;
@@ -426,4 +426,27 @@ fn clicking_the_image_probes_that_pixel_and_follows_the_strategy() {
     h.step();
     click_at(&mut h, at(30.0, 40.0), egui::Modifiers::COMMAND);
     step_until(&mut h, "a probe of pixel 30,40", |v| v.probe_view().is_some_and(|p| p.request.pixel == (30, 40)));
+}
+
+/// The measurement mode: "Fixed primary hits" sends the centre footprint to the integrator, the panel says what
+/// the errors then contain, and the reference it computes is the centre footprint's (the same image as a
+/// headless render with the reference settings), not the box-filtered picture's.
+#[test]
+fn fixed_primary_hits_reach_the_integrator_and_the_reference() {
+    let mut h = harness(viewer());
+    h.get_by_label("Fixed primary hits (measure the estimator)").click();
+    h.step();
+    step_until(&mut h, "a centre-footprint frame", |v| {
+        v.frame().is_some_and(|f| f.settings.footprint == Footprint::Centre)
+    });
+    assert!(h.query_by_label_contains("Errors: fixed primary hits").is_some(), "the mode is said");
+    h.get_by_label("Compute reference").click();
+    h.step();
+    step_until(&mut h, "the reference", |v| v.reference().is_some());
+    let reference = h.state().reference().expect("ready").clone();
+    let scene = Arc::new(h.state().scene().clone());
+    let mut film = Film::new(48, 48);
+    let settings = illumlab::measure::reference_settings(Footprint::Centre);
+    Renderer::new(scene, settings).render_pass(&mut film, 0, reference.spp, &|| false);
+    assert!(film.means() == reference.mean, "the reference is the centre footprint's");
 }

@@ -2,7 +2,7 @@
 //! (image or error map); the reference (status, spp, compute, load an EXR); export.
 
 use super::viewer::Viewer;
-use crate::render::Strategy;
+use crate::render::{Footprint, Strategy};
 use crate::session::views::View;
 use crate::session::worker::{Budget, ReferenceStatus};
 use std::path::PathBuf;
@@ -47,6 +47,7 @@ pub fn compare_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     }
     ui.separator();
     view_ui(v, ui);
+    footprint_ui(v, ui);
     ui.separator();
     reference_ui(v, ui);
     if v.comparing {
@@ -79,6 +80,23 @@ fn view_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     if view != View::Image {
         ui.small(view.description());
     }
+}
+
+/// Pictures or measurements: a jittered footprint antialiases, fixed primary hits leave the estimator's error
+/// alone (and a reference rendered the same way).
+fn footprint_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+    let mut fixed = v.settings.footprint == Footprint::Centre;
+    if ui
+        .checkbox(&mut fixed, "Fixed primary hits (measure the estimator)")
+        .on_hover_text(
+            "Every sample goes through its pixel's centre: the jitter of the pixel footprint, common to every \
+             strategy, leaves the error, and the reference is rendered the same way. Off: a box filter, for pictures.",
+        )
+        .changed()
+    {
+        v.set_footprint(if fixed { Footprint::Centre } else { Footprint::Jittered });
+    }
+    ui.small(format!("Errors: {}.", v.settings.footprint.description()));
 }
 
 fn reference_ui(v: &mut Viewer, ui: &mut egui::Ui) {

@@ -33,6 +33,7 @@ pub fn convergence_window(v: &mut Viewer, ui: &mut egui::Ui) {
             ui.radio_value(&mut v.plot_relative, false, "RMSE");
             ui.radio_value(&mut v.plot_relative, true, "relative RMSE, sqrt(relMSE)");
         });
+        ui.label(format!("Measured with {}.", v.settings.footprint.description()));
         ui.small(if v.plot_relative {
             "Each pixel's error relative to its brightness: dark regions count as much as visible lights."
         } else {

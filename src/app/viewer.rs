@@ -3,7 +3,7 @@
 use super::loader::Loading;
 use super::orbit;
 use crate::measure::{ColorScale, Series, default_cache_folder};
-use crate::render::{RenderSettings, Strategy};
+use crate::render::{Footprint, RenderSettings, Strategy};
 use crate::scene::{Camera, Material, Scene};
 use crate::session::snapshot::{display_rgba, write_snapshot};
 use crate::session::views::{View, shared_scale, unavailable, view_values};
@@ -346,7 +346,15 @@ impl Viewer {
         }
     }
 
-    /// Sends A's settings; B follows A's light selection, MIS settings and seed (its own strategy).
+    /// Where camera rays go in their pixels, for A and B and the reference (which restarts with it).
+    pub(super) fn set_footprint(&mut self, footprint: Footprint) {
+        if self.settings.footprint != footprint {
+            self.settings.footprint = footprint;
+            self.apply_settings();
+        }
+    }
+
+    /// Sends A's settings; B follows A's light selection, MIS settings, seed and footprint (its own strategy).
     pub(super) fn apply_settings(&mut self) {
         self.send_restarting(Command::SetSettings(self.settings));
         let b = RenderSettings { strategy: self.settings_b.strategy, ..self.settings };

@@ -1,12 +1,14 @@
 //! `illumlab bench`: every strategy at several budgets against a reference, written as CSV, markdown and a plot.
 
-use super::{MisArgs, load_sized, parse_light_selection, parse_size, parse_strategy, pass_size, thread_pool};
+use super::{
+    MisArgs, load_sized, parse_footprint, parse_light_selection, parse_size, parse_strategy, pass_size, thread_pool,
+};
 use anyhow::{Context, Result, bail};
 use illumlab::measure::{
-    BenchContext, Metric, Reference, machine_description, markdown, reference_settings, run_bench,
-    write_convergence_png, write_csv,
+    BenchContext, BenchPlan, Metric, Reference, machine_description, markdown, reference_settings, run_bench,
+    sees_emitter, write_convergence_png, write_csv,
 };
-use illumlab::render::{Film, RenderSettings, Renderer, Strategy, check_output_path};
+use illumlab::render::{Film, Footprint, RenderSettings, Renderer, Strategy, check_output_path};
 use illumlab::scene::{LightSelection, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -33,8 +35,20 @@ pub struct BenchArgs {
     /// Image size WxH, overriding the scene's camera.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// The first seed; each strategy renders with seeds SEED, SEED+1, … (see --seeds).
     #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
+    /// Independent runs per strategy, for the means and 95% intervals (a winner is declared only when the
+    /// intervals separate).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub seeds: u32,
+    /// Where camera rays go in their pixels: centre (fixed primary hits: the error is the estimator's alone) or
+    /// jittered (the box filter of pictures: the error includes the footprint's noise, common to every strategy).
+    #[arg(long, value_parser = parse_footprint, default_value = "centre")]
+    pub footprint: Footprint,
+    /// Measure the pixels that see an emitter directly too (left out by default).
+    #[arg(long)]
+    pub include_emitter_pixels: bool,
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
     pub light_selection: LightSelection,
     #[command(flatten)]
@@ -60,15 +74,17 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         Some(path) => {
             let r = Reference::load_exr(path)?;
             r.check_size(w, h)?;
-            (r, format!("{} (given)", path.display()))
+            (r, format!("{} (given: it must be rendered with the {} footprint)", path.display(), args.footprint.name()))
         }
         None => {
             let spp = args.reference_spp.unwrap_or(16 * budgets.last().copied().unwrap_or(1));
-            let r = pool.install(|| render_reference(&scene, spp));
+            let r = pool.install(|| render_reference(&scene, spp, args.footprint));
             let path = out.join("reference.exr");
             r.save_exr(&path)?;
             let line = format!(
-                "MIS (projected-solid-angle + BRDF, power heuristic), {spp} spp, rendered in {:.1} s, saved as {}",
+                "MIS (projected-solid-angle + BRDF, power heuristic), {spp} spp, {} footprint, rendered in {:.1} s, \
+                 saved as {}",
+                args.footprint.name(),
                 r.seconds,
                 path.display()
             );
@@ -82,10 +98,14 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         light_selection: args.light_selection,
         seed: args.seed,
         mis: args.mis.settings(),
+        footprint: args.footprint,
     };
+    let included: Option<Vec<bool>> =
+        (!args.include_emitter_pixels).then(|| sees_emitter(&scene, args.footprint).into_iter().map(|s| !s).collect());
+    let plan = BenchPlan { base, strategies, spp: budgets.clone(), seeds: args.seeds };
     let report = pool.install(|| {
-        run_bench(&scene, &reference, base, &strategies, &budgets, |s, spp| {
-            if Some(&spp) == budgets.last() {
+        run_bench(&scene, &reference, &plan, included.as_deref(), |s, k, spp| {
+            if Some(&spp) == budgets.last() && k + 1 == args.seeds {
                 eprintln!("  {} done", s.name());
             }
         })
@@ -101,11 +121,16 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         height: h,
         reference: &reference_line,
         machine: &format!("{machine} ({threads} used)"),
+        footprint: args.footprint,
     };
     let md = markdown(&report, &ctx);
     write(&out.join("bench.md"), md.as_bytes())?;
     write_csv(&out.join("bench.csv"), &report).map_err(anyhow::Error::msg)?;
-    let title = format!("{} {w}x{h}: RMSE against the reference", scene.name);
+    let mode = match args.footprint {
+        Footprint::Centre => "fixed hits",
+        Footprint::Jittered => "jittered footprint",
+    };
+    let title = format!("{} {w}x{h}, {mode}: estimator RMSE, mean of {} seeds", scene.name, args.seeds);
     write_convergence_png(
         &out.join("convergence.png"),
         &title,
@@ -114,7 +139,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         Metric::Mse,
         WALL,
     )?;
-    let title = format!("{} {w}x{h}: relative RMSE against the reference", scene.name);
+    let title = format!("{} {w}x{h}, {mode}: estimator relative RMSE, mean of {} seeds", scene.name, args.seeds);
     let floor = reference.noise_rel_mse().sqrt();
     write_convergence_png(&out.join("convergence-relative.png"), &title, &report.series, floor, Metric::RelMse, WALL)?;
     println!("{md}");
@@ -125,8 +150,8 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 const WALL: &str = "wall-clock seconds";
 
 /// Renders the reference with [`reference_settings`] in passes of a few samples.
-fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32) -> Reference {
-    let renderer = Renderer::new(scene.clone(), reference_settings());
+fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32, footprint: Footprint) -> Reference {
+    let renderer = Renderer::new(scene.clone(), reference_settings(footprint));
     let mut film = Film::new(scene.camera.width, scene.camera.height);
     let chunk = pass_size(spp, film.pixels.len());
     let bar = indicatif::ProgressBar::new(spp as u64).with_style(

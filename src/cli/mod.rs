@@ -6,7 +6,8 @@ mod probe;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use illumlab::render::{
-    Film, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path, write_image,
+    Film, Footprint, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
+    write_image,
 };
 use illumlab::scene::{LightSelection, Scene, load_scene};
 use illumlab::session::views::View;
@@ -54,6 +55,10 @@ pub struct RenderArgs {
     /// How light strategies pick a triangle: uniform, area, power or contribution.
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
     pub light_selection: LightSelection,
+    /// Where camera rays go in their pixels: jittered (a box filter, for pictures) or centre (fixed primary hits,
+    /// to measure the estimator against a reference rendered the same way).
+    #[arg(long, value_parser = parse_footprint, default_value = "jittered")]
+    pub footprint: Footprint,
     /// Image size WxH, overriding the scene's camera.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -179,6 +184,10 @@ fn parse_view(s: &str) -> Result<View, String> {
     })
 }
 
+pub(crate) fn parse_footprint(s: &str) -> Result<Footprint, String> {
+    Footprint::from_name(s).ok_or_else(|| "unknown footprint (one of: jittered, centre)".to_string())
+}
+
 pub(crate) fn parse_light_selection(s: &str) -> Result<LightSelection, String> {
     LightSelection::from_name(s)
         .ok_or_else(|| "unknown light selection (one of: uniform, area, power, contribution)".to_string())
@@ -220,6 +229,7 @@ pub fn run(command: Command) -> Result<()> {
                 light_selection: args.light_selection,
                 seed: args.seed,
                 mis: args.mis.settings(),
+                footprint: Footprint::Jittered,
             },
             target_spp: args.target_spp,
             exposure: args.exposure,
@@ -246,6 +256,7 @@ fn render(args: RenderArgs) -> Result<()> {
         light_selection: args.light_selection,
         seed: args.seed,
         mis: args.mis.settings(),
+        footprint: args.footprint,
     };
     let mut film = Film::new(scene.camera.width, scene.camera.height);
     let renderer = Renderer::new(std::sync::Arc::new(scene), settings);

@@ -5,7 +5,7 @@ use super::{MisArgs, load_sized, parse_light_selection, parse_strategy};
 use anyhow::{Context, Result, bail};
 use illumlab::math::luminance;
 use illumlab::probe::{Layers, Probe, ProbeJson, ProbeSettings, chi2};
-use illumlab::render::{RenderSettings, Strategy, check_output_path, write_png_rgba};
+use illumlab::render::{Footprint, RenderSettings, Strategy, check_output_path, write_png_rgba};
 use illumlab::scene::LightSelection;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -68,6 +68,7 @@ pub fn probe(args: ProbeArgs) -> Result<()> {
         light_selection: args.light_selection,
         seed: args.seed,
         mis: args.mis.settings(),
+        footprint: Footprint::Jittered,
     };
     let probe = Probe::new(scene.clone(), settings);
     let point = probe

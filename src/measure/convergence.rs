@@ -104,6 +104,13 @@ pub enum Metric {
 }
 
 impl Metric {
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Mse => "MSE",
+            Metric::RelMse => "relMSE",
+        }
+    }
+
     pub fn efficiency(self, p: &ConvergencePoint) -> Option<f64> {
         match self {
             Metric::Mse => p.efficiency(),

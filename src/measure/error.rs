@@ -6,12 +6,13 @@
 //! ```
 //!
 //! For an unbiased estimator `E[MSE] = Var(estimate) + Var(reference)`: the first term falls as 1/N, the second is
-//! the reference's own noise floor, known for a rendered reference (`σ̂²/N_ref` per pixel). It is reported beside
-//! the MSE and drawn in the plots, not subtracted: a reference with many more samples than the estimate keeps it
-//! small (the bench uses 16× the largest budget); the convergence test subtracts it.
+//! the reference's own noise floor, known for a rendered reference (`σ̂²/N_ref` per pixel). The viewer reports it
+//! beside the MSE and draws it in the plots; the bench subtracts it ([`ErrorMetrics::estimator_mse`]), over the
+//! same pixels: [`error_over`] leaves some out (those that see an emitter directly, see
+//! [`super::sees_emitter`]).
 
 use super::Reference;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 /// ε in relMSE: keeps black pixels from dominating.
 pub const REL_MSE_EPSILON: f64 = 1e-2;
@@ -20,13 +21,26 @@ pub const REL_MSE_EPSILON: f64 = 1e-2;
 pub struct ErrorMetrics {
     pub mse: f64,
     pub rel_mse: f64,
-    /// The reference's own noise: mean `σ̂²/N_ref` (0 when unknown).
+    /// The reference's own noise over the same pixels: mean `σ̂²/N_ref` (0 when unknown).
     pub reference_mse: f64,
+    /// The same relative to the reference's brightness: mean `(σ̂²/N_ref) / (R² + ε)` (0 when unknown).
+    pub reference_rel_mse: f64,
 }
 
 impl ErrorMetrics {
     pub fn rmse(&self) -> f64 {
         self.mse.sqrt()
+    }
+
+    /// The estimator's own MSE: `MSE − Var(reference)`, an unbiased estimate of `Var(estimate)` (it can come out
+    /// slightly negative when the estimate is as good as the reference).
+    pub fn estimator_mse(&self) -> f64 {
+        self.mse - self.reference_mse
+    }
+
+    /// The same for relMSE.
+    pub fn estimator_rel_mse(&self) -> f64 {
+        self.rel_mse - self.reference_rel_mse
     }
 
     /// Monte Carlo efficiency `1 / (MSE · seconds)`: higher is better, independent of the budget for an unbiased
@@ -37,18 +51,34 @@ impl ErrorMetrics {
     }
 }
 
-/// The errors of `estimate` (per-pixel means, row 0 first) against `reference`, which must have the same size.
+/// The errors of `estimate` (per-pixel means, row 0 first) against `reference`, which must have the same size,
+/// over every pixel.
 pub fn error_vs_reference(estimate: &[Vec3], reference: &Reference) -> ErrorMetrics {
+    error_over(estimate, reference, None)
+}
+
+/// The errors over the pixels `included` marks (all when `None`; zero errors when it marks none).
+pub fn error_over(estimate: &[Vec3], reference: &Reference, included: Option<&[bool]>) -> ErrorMetrics {
     assert_eq!(estimate.len(), reference.mean.len(), "estimate and reference sizes differ");
-    let (mut se, mut rel) = (0.0f64, 0.0f64);
-    for (e, r) in estimate.iter().zip(&reference.mean) {
+    let eps = DVec3::splat(REL_MSE_EPSILON);
+    let (mut se, mut rel, mut var, mut rel_var, mut pixels) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0usize);
+    for (i, (e, r)) in estimate.iter().zip(&reference.mean).enumerate() {
+        if included.is_some_and(|inc| !inc[i]) {
+            continue;
+        }
         let (e, r) = (e.as_dvec3(), r.as_dvec3());
         let d2 = (e - r) * (e - r);
         se += d2.element_sum();
-        rel += (d2 / (r * r + glam::DVec3::splat(REL_MSE_EPSILON))).element_sum();
+        rel += (d2 / (r * r + eps)).element_sum();
+        if let Some(v) = &reference.var_of_mean {
+            let v = v[i].as_dvec3();
+            var += v.element_sum();
+            rel_var += (v / (r * r + eps)).element_sum();
+        }
+        pixels += 1;
     }
-    let n = (3 * estimate.len().max(1)) as f64;
-    ErrorMetrics { mse: se / n, rel_mse: rel / n, reference_mse: reference.noise_mse() }
+    let n = (3 * pixels.max(1)) as f64;
+    ErrorMetrics { mse: se / n, rel_mse: rel / n, reference_mse: var / n, reference_rel_mse: rel_var / n }
 }
 
 /// `|I − R|` per pixel, averaged over R, G, B: the absolute-error map.
@@ -86,6 +116,19 @@ mod tests {
         assert!((m.reference_mse - 0.03 / 6.0).abs() < 1e-9);
         assert_eq!(m.efficiency(2.0), Some(1.0 / (m.mse * 2.0)));
         assert_eq!(absolute_error_map(&e, &r)[0], 2.0 / 3.0);
+    }
+
+    #[test]
+    fn excluded_pixels_count_for_neither_the_error_nor_the_reference_noise() {
+        let r = reference(vec![Vec3::splat(1.0), Vec3::splat(0.0)], Some(vec![Vec3::splat(0.01), Vec3::splat(0.5)]));
+        let e = [Vec3::new(1.0, 1.0, 3.0), Vec3::splat(0.1)];
+        let m = error_over(&e, &r, Some(&[true, false]));
+        assert!((m.mse - 4.0 / 3.0).abs() < 1e-7);
+        assert!((m.reference_mse - 0.01).abs() < 1e-9);
+        assert!((m.reference_rel_mse - 0.01 / 1.01).abs() < 1e-9);
+        assert!((m.estimator_mse() - (4.0 / 3.0 - 0.01)).abs() < 1e-7);
+        assert_eq!(error_over(&e, &r, Some(&[false, false])).mse, 0.0);
+        assert_eq!(error_over(&e, &r, None), error_vs_reference(&e, &r));
     }
 
     #[test]

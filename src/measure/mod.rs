@@ -4,16 +4,20 @@
 
 mod bench;
 mod convergence;
+mod emitter_pixels;
 mod error;
 mod heatmap;
+mod interval;
 mod plot;
 mod reference;
 mod report;
 
-pub use bench::{BenchReport, BenchRow, run_bench};
+pub use bench::{BenchPlan, BenchReport, BenchRow, run_bench};
 pub use convergence::{ConvergencePoint, Metric, Series, most_efficient};
-pub use error::{ErrorMetrics, REL_MSE_EPSILON, absolute_error_map, error_vs_reference};
+pub use emitter_pixels::sees_emitter;
+pub use error::{ErrorMetrics, REL_MSE_EPSILON, absolute_error_map, error_over, error_vs_reference};
 pub use heatmap::{ColorScale, gradient};
+pub use interval::{MeanInterval, Ratio, student_t_975};
 pub use plot::{convergence_rgba, write_convergence_png};
 pub use reference::{
     REFERENCE_SEED, Reference, ReferenceError, ReferenceOrigin, cache_path, default_cache_folder, load_cached,

@@ -6,7 +6,7 @@
 //! materials, camera) and the reference's spp and seed, but not the estimator under study: every unbiased strategy
 //! converges to the same image, so toggling strategies never invalidates the reference.
 
-use crate::render::{Film, Heuristic, MisSettings, RenderSettings, Strategy};
+use crate::render::{Film, Footprint, Heuristic, MisSettings, RenderSettings, Strategy};
 use crate::scene::{LightSelection, Scene};
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -17,9 +17,12 @@ pub const REFERENCE_SEED: u64 = 0x05EE_D0F2_EFE2_E4CE;
 
 /// The estimator behind rendered references: MIS of projected-solid-angle light sampling and Phong-BRDF sampling
 /// with the power heuristic, triangles picked by power. It is robust on every bundled scene: light sampling
-/// handles small and near lights, BRDF sampling glossy lobes (see the README's variance tables).
-pub fn reference_settings() -> RenderSettings {
+/// handles small and near lights, BRDF sampling glossy lobes (see the README's variance tables). The footprint
+/// must be the estimates': a jittered reference converges to the box-filtered image, a centred one to the
+/// value at each pixel's centre.
+pub fn reference_settings(footprint: Footprint) -> RenderSettings {
     RenderSettings {
+        footprint,
         strategy: Strategy::Mis,
         light_selection: LightSelection::Power,
         seed: REFERENCE_SEED,
@@ -184,12 +187,14 @@ fn read_rgb(path: &Path) -> Result<(u32, u32, Vec<Vec3>), ReferenceError> {
     Ok((size.width() as u32, size.height() as u32, values))
 }
 
-/// The cache key of a rendered reference: FNV-1a over everything the image converges to, and the reference's
-/// spp. Names, file paths and the estimator under study are not part of it.
-pub fn reference_key(scene: &Scene, spp: u32) -> u64 {
+/// The cache key of a rendered reference: FNV-1a over everything the image converges to (the footprint among
+/// it), and the reference's spp. Names, file paths and the estimator under study are not part of it. The version
+/// string changes when the renderer's images do (v2: error-bounded ray offsets).
+pub fn reference_key(scene: &Scene, spp: u32, footprint: Footprint) -> u64 {
     let mut h = Fnv1a::new();
-    h.bytes(b"illumlab-reference-v1");
-    let s = reference_settings();
+    h.bytes(b"illumlab-reference-v2");
+    h.bytes(footprint.name().as_bytes());
+    let s = reference_settings(footprint);
     h.u64(s.seed);
     h.u64(spp as u64);
     let c = &scene.camera;
@@ -212,10 +217,11 @@ pub fn reference_key(scene: &Scene, spp: u32) -> u64 {
 }
 
 /// The cache file of a rendered reference in `folder`.
-pub fn cache_path(folder: &Path, scene: &Scene, spp: u32) -> PathBuf {
+pub fn cache_path(folder: &Path, scene: &Scene, spp: u32, footprint: Footprint) -> PathBuf {
     let name: String =
         scene.name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect();
-    folder.join(format!("{name}-{:016x}-{spp}spp.exr", reference_key(scene, spp)))
+    let key = reference_key(scene, spp, footprint);
+    folder.join(format!("{name}-{key:016x}-{spp}spp-{}.exr", footprint.name()))
 }
 
 /// The default cache folder: `$XDG_CACHE_HOME/illumlab/references`, else `~/.cache/illumlab/references`.
@@ -227,9 +233,9 @@ pub fn default_cache_folder() -> Option<PathBuf> {
     Some(base.join("illumlab").join("references"))
 }
 
-/// Loads a cached reference if one exists for this scene and spp.
-pub fn load_cached(folder: &Path, scene: &Scene, spp: u32) -> Option<Reference> {
-    let path = cache_path(folder, scene, spp);
+/// Loads a cached reference if one exists for this scene, spp and footprint.
+pub fn load_cached(folder: &Path, scene: &Scene, spp: u32, footprint: Footprint) -> Option<Reference> {
+    let path = cache_path(folder, scene, spp, footprint);
     let mut r = Reference::load_exr(&path).ok()?;
     r.check_size(scene.camera.width, scene.camera.height).ok()?;
     r.spp = spp;
@@ -238,8 +244,13 @@ pub fn load_cached(folder: &Path, scene: &Scene, spp: u32) -> Option<Reference> 
 }
 
 /// Stores a rendered reference in the cache (creating the folder); returns the file written.
-pub fn store_cached(folder: &Path, scene: &Scene, reference: &Reference) -> Result<PathBuf, ReferenceError> {
-    let path = cache_path(folder, scene, reference.spp);
+pub fn store_cached(
+    folder: &Path,
+    scene: &Scene,
+    reference: &Reference,
+    footprint: Footprint,
+) -> Result<PathBuf, ReferenceError> {
+    let path = cache_path(folder, scene, reference.spp, footprint);
     std::fs::create_dir_all(folder).map_err(|e| ReferenceError::Write(folder.to_path_buf(), e.to_string()))?;
     reference.save_exr(&path)?;
     Ok(path)
@@ -273,6 +284,8 @@ mod tests {
     use crate::render::Renderer;
     use crate::scene::load_scene;
 
+    const J: Footprint = Footprint::Jittered;
+
     fn small(name: &str) -> Scene {
         let mut scene = load_scene(name).expect("bundled");
         scene.camera.width = 8;
@@ -283,39 +296,41 @@ mod tests {
     #[test]
     fn key_follows_what_the_image_converges_to() {
         let scene = small("cornell-box");
-        let k = reference_key(&scene, 64);
-        assert_eq!(k, reference_key(&scene.clone(), 64));
-        assert_ne!(k, reference_key(&scene, 128), "spp");
+        let k = reference_key(&scene, 64, J);
+        assert_eq!(k, reference_key(&scene.clone(), 64, J));
+        assert_ne!(k, reference_key(&scene, 128, J), "spp");
         let mut moved = scene.clone();
         moved.camera.eye.x += 1e-3;
-        assert_ne!(k, reference_key(&moved, 64), "camera");
+        assert_ne!(k, reference_key(&moved, 64, J), "camera");
         let mut glossier = scene.clone();
         glossier.materials[0].alpha += 1.0;
-        assert_ne!(k, reference_key(&glossier, 64), "material");
+        assert_ne!(k, reference_key(&glossier, 64, J), "material");
         let mut renamed = scene.clone();
         renamed.name = "other".into();
-        assert_eq!(k, reference_key(&renamed, 64), "the name is not content");
+        assert_eq!(k, reference_key(&renamed, 64, J), "the name is not content");
+        assert_ne!(k, reference_key(&scene, 64, Footprint::Centre), "footprint");
     }
 
     #[test]
     fn cache_round_trip_keeps_mean_and_variance() {
         let scene = small("cornell-box");
         let mut film = Film::new(8, 6);
-        Renderer::new(std::sync::Arc::new(scene.clone()), reference_settings()).render_pass(&mut film, 0, 8, &|| false);
+        Renderer::new(std::sync::Arc::new(scene.clone()), reference_settings(J))
+            .render_pass(&mut film, 0, 8, &|| false);
         let reference = Reference::from_film(&film, 0.5);
         assert_eq!(reference.spp, 8);
         assert!(reference.noise_mse() > 0.0 && reference.noise_rel_mse() > 0.0);
         let dir = tempfile::tempdir().expect("temp dir");
-        assert!(load_cached(dir.path(), &scene, 8).is_none(), "nothing cached yet");
-        let path = store_cached(dir.path(), &scene, &reference).expect("stored");
+        assert!(load_cached(dir.path(), &scene, 8, J).is_none(), "nothing cached yet");
+        let path = store_cached(dir.path(), &scene, &reference, J).expect("stored");
         assert!(variance_path(&path).exists());
-        let back = load_cached(dir.path(), &scene, 8).expect("cached");
+        let back = load_cached(dir.path(), &scene, 8, J).expect("cached");
         assert_eq!(back.mean, reference.mean);
         assert_eq!(back.var_of_mean, reference.var_of_mean);
         assert_eq!(back.origin, ReferenceOrigin::Cache(path));
         let mut other = scene.clone();
         other.camera.fov_y += 1.0;
-        assert!(load_cached(dir.path(), &other, 8).is_none(), "another camera misses");
+        assert!(load_cached(dir.path(), &other, 8, J).is_none(), "another camera misses");
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Bench results as files: CSV (one row per strategy and budget) and a markdown table with the machine named.
 
-use super::{BenchReport, BenchRow, Metric, most_efficient};
+use super::{BenchReport, BenchRow, MeanInterval, Metric, Ratio};
+use crate::render::Footprint;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -12,6 +13,7 @@ pub struct BenchContext<'a> {
     /// How the reference came about, one line.
     pub reference: &'a str,
     pub machine: &'a str,
+    pub footprint: Footprint,
 }
 
 /// Writes the rows as CSV.
@@ -23,57 +25,111 @@ pub fn write_csv(path: &Path, report: &BenchReport) -> Result<(), String> {
     w.flush().map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// The markdown report: a heading with scene, size, reference and machine; one table row per strategy and budget
-/// with both efficiencies, the best at each budget in bold; then the winners at the largest budget.
+/// A value with its interval: `1.23e-3 [1.10e-3, 1.40e-3]`; an open end where unbounded.
+fn with_interval(value: Option<f64>, lo: Option<f64>, hi: Option<f64>, bold: bool) -> String {
+    let Some(v) = value else { return "—".into() };
+    let end = |e: Option<f64>| e.filter(|e| e.is_finite()).map_or("∞".to_string(), |e| format!("{e:.2e}"));
+    let lo = lo.filter(|l| l.is_finite()).map_or("–∞".to_string(), |l| format!("{l:.2e}"));
+    let v = if bold { format!("**{v:.3e}**") } else { format!("{v:.3e}") };
+    format!("{v} [{lo}, {}]", end(hi))
+}
+
+/// The verdict at the largest budget by one metric: the strategy with the highest efficiency against the
+/// runner-up, declared the winner only when the 95% interval of their efficiency ratio excludes 1.
+fn verdict(report: &BenchReport, metric: Metric) -> Option<String> {
+    let last = report.intervals.first()?.len().checked_sub(1)?;
+    let spp = report.series.first()?.points.last()?.spp;
+    let k = if metric == Metric::Mse { 0 } else { 1 };
+    // Per strategy: (label, MSE interval at the largest budget, seconds).
+    let mut ranked: Vec<(&str, MeanInterval, f64)> = report
+        .series
+        .iter()
+        .zip(&report.intervals)
+        .filter_map(|(s, i)| Some((s.label.as_str(), i[last][k], s.points.last()?.seconds)))
+        .filter(|(_, m, t)| m.mean > 0.0 && *t > 0.0)
+        .collect();
+    ranked.sort_by(|a, b| (a.1.mean * a.2).total_cmp(&(b.1.mean * b.2)));
+    let by = metric.name();
+    let (best, runner) = match ranked.as_slice() {
+        [] => return None,
+        [only] => return Some(format!("By {by} at {spp} spp: **{}** (the only one measured).", only.0)),
+        [a, b, ..] => (a, b),
+    };
+    // E_A/E_B = (MSE_B t_B)/(MSE_A t_A); the times are means, nearly exact beside the MSEs' spread.
+    let Some(r) = Ratio::of(&runner.1, &best.1) else {
+        return Some(format!(
+            "By {by} at {spp} spp: **{}** has the highest mean efficiency; one seed gives no interval, so no winner is declared.",
+            best.0
+        ));
+    };
+    let scale = runner.2 / best.2;
+    let (ratio, lo, hi) = (r.ratio * scale, r.lo * scale, r.hi * scale);
+    Some(if lo > 1.0 {
+        format!(
+            "By {by} at {spp} spp: **{}** is the most efficient, {ratio:.2}× {} (95%: {lo:.2}–{hi:.2}×).",
+            best.0, runner.0
+        )
+    } else {
+        format!(
+            "By {by} at {spp} spp: no significant difference between **{}** and **{}** ({ratio:.2}×, 95%: {lo:.2}–{hi:.2}×).",
+            best.0, runner.0
+        )
+    })
+}
+
+/// The markdown report: a heading with scene, size, reference, machine and what the error contains; one table
+/// row per strategy and budget with means and 95% intervals over the seeds, the best mean at each budget in bold;
+/// then the verdicts at the largest budget.
 pub fn markdown(report: &BenchReport, ctx: &BenchContext) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "### {} at {}×{}\n", ctx.scene, ctx.width, ctx.height);
     let _ = writeln!(md, "Machine: {}. Reference: {}.", ctx.machine, ctx.reference);
-    if report.reference_rmse > 0.0 {
-        let _ = writeln!(md, "The reference's own RMSE (noise floor) is {:.2e}.", report.reference_rmse);
-    }
+    let seeds = report.rows.first().map_or(0, |r| r.seeds);
     let _ = writeln!(
         md,
-        "\n| strategy | spp | seconds | M samples/s | RMSE | relMSE | 1/(MSE·s) | 1/(relMSE·s) |\n|---|---:|---:|---:|---:|---:|---:|---:|"
+        "Measured with {}; {} of {} pixels (those that see an emitter) left out; the reference's own noise \
+         (RMSE {:.2e}) subtracted; means over {seeds} seed(s) with 95% intervals.",
+        ctx.footprint.description(),
+        report.excluded,
+        report.pixels + report.excluded,
+        report.reference_rmse,
+    );
+    let _ = writeln!(
+        md,
+        "\n| strategy | spp | seconds | M samples/s | RMSE | relMSE [95%] | 1/(MSE·s) [95%] | 1/(relMSE·s) [95%] |\n|---|---:|---:|---:|---:|---:|---:|---:|"
     );
     let best = |spp: u32, of: fn(&BenchRow) -> Option<f64>| {
         report.rows.iter().filter(|r| r.spp == spp).filter_map(of).fold(0.0f64, f64::max)
     };
-    let cell = |row: &BenchRow, of: fn(&BenchRow) -> Option<f64>| match of(row) {
-        Some(e) if e == best(row.spp, of) => format!("**{e:.3e}**"),
-        Some(e) => format!("{e:.3e}"),
-        None => "—".into(),
-    };
     for row in &report.rows {
+        let rel = with_interval(Some(row.rel_mse), Some(row.rel_mse_lo), Some(row.rel_mse_hi), false);
+        let eff = with_interval(
+            row.efficiency,
+            row.efficiency_lo,
+            row.efficiency_hi,
+            row.efficiency.is_some_and(|e| e == best(row.spp, |r| r.efficiency)),
+        );
+        let rel_eff = with_interval(
+            row.rel_efficiency,
+            row.rel_efficiency_lo,
+            row.rel_efficiency_hi,
+            row.rel_efficiency.is_some_and(|e| e == best(row.spp, |r| r.rel_efficiency)),
+        );
         let _ = writeln!(
             md,
-            "| {} | {} | {:.3} | {:.2} | {:.3e} | {:.3e} | {} | {} |",
+            "| {} | {} | {:.3} | {:.2} | {:.3e} | {rel} | {eff} | {rel_eff} |",
             row.strategy,
             row.spp,
             row.seconds,
             row.samples_per_second / 1e6,
             row.rmse,
-            row.rel_mse,
-            cell(row, |r| r.efficiency),
-            cell(row, |r| r.rel_efficiency),
         );
     }
-    let winner = |metric: Metric| {
-        let i = most_efficient(&report.series, metric)?;
-        let s = &report.series[i];
-        let e = s.last().and_then(|p| metric.efficiency(p))?;
-        let runner_up = report
-            .series
-            .iter()
-            .enumerate()
-            .filter(|(j, _)| *j != i)
-            .filter_map(|(_, t)| t.last().and_then(|p| metric.efficiency(p)))
-            .fold(0.0f64, f64::max);
-        let margin = if runner_up > 0.0 { format!(" ({:.2}× the runner-up)", e / runner_up) } else { String::new() };
-        Some((s.last().map_or(0, |p| p.spp), format!("**{}**{margin}", s.label)))
-    };
-    if let (Some((spp, by_mse)), Some((_, by_rel))) = (winner(Metric::Mse), winner(Metric::RelMse)) {
-        let _ = writeln!(md, "\nMost efficient at {spp} spp: {by_mse} by MSE, {by_rel} by relMSE.");
+    md.push('\n');
+    for metric in [Metric::Mse, Metric::RelMse] {
+        if let Some(v) = verdict(report, metric) {
+            let _ = writeln!(md, "{v}");
+        }
     }
     md
 }
@@ -98,46 +154,81 @@ mod tests {
     use super::*;
     use crate::measure::{BenchRow, ConvergencePoint, Series};
 
-    fn report() -> BenchReport {
-        let row = |strategy: &str, spp, seconds, rmse: f64, rel_mse: f64| BenchRow {
-            strategy: strategy.into(),
-            spp,
-            seconds,
-            samples_per_second: 1e6,
-            rmse,
-            rel_mse,
-            efficiency: Some(1.0 / (rmse * rmse * seconds)),
-            rel_efficiency: Some(1.0 / (rel_mse * seconds)),
-            non_finite_dropped: 0,
-        };
-        let mut a = Series::new("cosine");
-        a.push(ConvergencePoint { spp: 4, seconds: 1.0, mse: 0.04, rel_mse: 0.2 });
-        let mut b = Series::new("emitter");
-        b.push(ConvergencePoint { spp: 4, seconds: 2.0, mse: 0.01, rel_mse: 0.3 });
-        let rows = vec![row("cosine", 4, 1.0, 0.2, 0.2), row("emitter", 4, 2.0, 0.1, 0.3)];
-        BenchReport { rows, series: vec![a, b], reference_rmse: 1e-3 }
+    /// Two strategies at 4 spp, from per-seed MSEs; `seconds` each.
+    fn report(a: &[f64], b: &[f64], seconds: [f64; 2]) -> BenchReport {
+        let names = ["cosine", "emitter"];
+        let (mut rows, mut series, mut intervals) = (vec![], vec![], vec![]);
+        for (k, values) in [a, b].into_iter().enumerate() {
+            let m = MeanInterval::of(values);
+            let t = seconds[k];
+            rows.push(BenchRow {
+                strategy: names[k].into(),
+                spp: 4,
+                seeds: values.len() as u32,
+                seconds: t,
+                samples_per_second: 1e6,
+                rmse: m.mean.sqrt(),
+                mse: m.mean,
+                mse_lo: m.lo(),
+                mse_hi: m.hi(),
+                rel_mse: m.mean,
+                rel_mse_lo: m.lo(),
+                rel_mse_hi: m.hi(),
+                efficiency: Some(1.0 / (m.mean * t)),
+                efficiency_lo: Some(1.0 / (m.hi() * t)),
+                efficiency_hi: (m.lo() > 0.0).then(|| 1.0 / (m.lo() * t)),
+                rel_efficiency: Some(1.0 / (m.mean * t)),
+                rel_efficiency_lo: Some(1.0 / (m.hi() * t)),
+                rel_efficiency_hi: (m.lo() > 0.0).then(|| 1.0 / (m.lo() * t)),
+                non_finite_dropped: 0,
+            });
+            let mut s = Series::new(names[k]);
+            s.push(ConvergencePoint { spp: 4, seconds: t, mse: m.mean, rel_mse: m.mean });
+            series.push(s);
+            intervals.push(vec![[m, m]]);
+        }
+        BenchReport { rows, intervals, series, reference_rmse: 1e-3, pixels: 90, excluded: 10 }
+    }
+
+    fn ctx() -> BenchContext<'static> {
+        BenchContext { scene: "s", width: 10, height: 10, reference: "r", machine: "m", footprint: Footprint::Centre }
     }
 
     #[test]
-    fn markdown_marks_the_winner_and_names_the_machine() {
-        let ctx = BenchContext { scene: "s", width: 2, height: 2, reference: "r", machine: "m" };
-        let md = markdown(&report(), &ctx);
+    fn markdown_names_the_machine_and_what_the_error_contains() {
+        let md = markdown(&report(&[0.04, 0.05, 0.03], &[0.01, 0.011, 0.009], [1.0, 1.0]), &ctx());
         assert!(md.contains("Machine: m"), "{md}");
-        assert!(md.contains("| emitter | 4 | 2.000 | 1.00 | 1.000e-1 | 3.000e-1 | **5.000e1** | 1.667e0 |"), "{md}");
-        assert!(md.contains("| cosine | 4 | 1.000 | 1.00 | 2.000e-1 | 2.000e-1 | 2.500e1 | **5.000e0** |"), "{md}");
-        let winners = "Most efficient at 4 spp: **emitter** (2.00× the runner-up) by MSE, **cosine** (3.00× the runner-up) by relMSE";
-        assert!(md.contains(winners), "{md}");
+        assert!(md.contains("fixed primary hits"), "{md}");
+        assert!(md.contains("10 of 100 pixels"), "{md}");
+        assert!(md.contains("means over 3 seed(s) with 95% intervals"), "{md}");
+        assert!(
+            md.contains("| emitter | 4 | 1.000 | 1.00 | 1.000e-1 | 1.000e-2 [7.52e-3, 1.25e-2] | **1.000e2**"),
+            "{md}"
+        );
+    }
+
+    #[test]
+    fn a_winner_only_where_the_intervals_separate() {
+        let md = markdown(&report(&[0.04, 0.05, 0.03], &[0.01, 0.011, 0.009], [1.0, 1.0]), &ctx());
+        assert!(md.contains("By MSE at 4 spp: **emitter** is the most efficient, 4.00× cosine"), "{md}");
+        let md = markdown(&report(&[0.010, 0.013, 0.008], &[0.01, 0.011, 0.009], [1.0, 1.0]), &ctx());
+        assert!(md.contains("By MSE at 4 spp: no significant difference between **emitter** and **cosine**"), "{md}");
+        // Time counts: a strategy with 4× the MSE in a fifth of the time is the more efficient.
+        let md = markdown(&report(&[0.04, 0.05, 0.03], &[0.01, 0.011, 0.009], [0.2, 1.0]), &ctx());
+        assert!(md.contains("**cosine** and **emitter** (1.25×"), "{md}");
+        let md = markdown(&report(&[0.04], &[0.01], [1.0, 1.0]), &ctx());
+        assert!(md.contains("one seed gives no interval, so no winner is declared"), "{md}");
     }
 
     #[test]
     fn csv_has_a_header_and_a_row_per_budget() {
         let dir = tempfile::tempdir().expect("temp dir");
         let path = dir.path().join("b.csv");
-        write_csv(&path, &report()).expect("written");
+        write_csv(&path, &report(&[0.04, 0.05], &[0.01, 0.02], [1.0, 2.0])).expect("written");
         let text = std::fs::read_to_string(&path).expect("read");
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), 3);
-        assert!(lines[0].starts_with("strategy,spp,seconds,samples_per_second,rmse,rel_mse,efficiency"), "{text}");
-        assert!(lines[2].starts_with("emitter,4,2.0,"), "{text}");
+        assert!(lines[0].starts_with("strategy,spp,seeds,seconds,samples_per_second,rmse,mse,mse_lo,mse_hi"), "{text}");
+        assert!(lines[2].starts_with("emitter,4,2,2.0,"), "{text}");
     }
 }

@@ -3,6 +3,7 @@
 mod cones;
 mod estimator;
 mod film;
+mod footprint;
 mod lanes;
 mod output;
 mod pass;
@@ -13,6 +14,7 @@ pub mod strategy;
 pub use cones::PixelCones;
 pub use estimator::{SEGMENT_END, estimate_direct, reached, shadow_ray_ends, visible};
 pub use film::{Film, PixelAccum};
+pub use footprint::Footprint;
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;

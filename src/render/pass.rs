@@ -4,7 +4,7 @@
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
 use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
-use super::{Film, PixelAccum, PixelCones, ShadingPoint, Strategy};
+use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
@@ -29,6 +29,8 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Used by [`Strategy::Mis`].
     pub mis: MisSettings,
+    /// Where camera rays go in their pixels.
+    pub footprint: Footprint,
 }
 
 impl Default for RenderSettings {
@@ -38,6 +40,7 @@ impl Default for RenderSettings {
             light_selection: LightSelection::Power,
             seed: 0,
             mis: MisSettings::default(),
+            footprint: Footprint::Jittered,
         }
     }
 }
@@ -194,10 +197,11 @@ impl Renderer {
             })
     }
 
-    /// A camera ray through a uniformly jittered position in pixel (x, y) (box filter) and its closest hit.
+    /// A camera ray through pixel (x, y), at a uniformly jittered position (box filter) or its centre (see
+    /// [`Footprint`]), and its closest hit.
     #[inline]
     fn camera_ray(&self, x: u32, y: u32, rng: &mut SampleRng) -> (Vec3, Option<Hit>) {
-        let dir = self.camera.direction(x, y, rng.uniform_2d());
+        let dir = self.camera.direction(x, y, self.settings.footprint.position(rng.uniform_2d()));
         (dir, self.scene.accel().closest_hit(self.camera.eye(), dir, f32::INFINITY))
     }
 
@@ -215,9 +219,16 @@ impl Renderer {
     ) -> [Vec3; LANES] {
         let n = samples.len();
         let mut rngs = streams.samples(samples.start as u64);
-        let (jitter_x, jitter_y) = (rngs.uniform(), rngs.uniform());
+        let footprint = self.settings.footprint;
+        let (jitter_x, jitter_y) = (footprint.positions(rngs.uniform()), footprint.positions(rngs.uniform()));
         let dirs = self.camera.directions(x, y, jitter_x, jitter_y);
         let hits = match cone {
+            // Every sample's ray is the centre's: traced once, as `camera_ray` traces it (a packet could break a
+            // tie between two triangles, on an edge through the centre, the other way).
+            _ if footprint == Footprint::Centre => {
+                let hit = self.scene.accel().closest_hit(self.camera.eye(), dirs.lane(0), f32::INFINITY);
+                HitLanes::from_hits(&std::array::from_fn(|l| if l < n { hit } else { None }))
+            }
             Some(cone) => {
                 // All bits set in lanes 0..n (a comparison's true).
                 let active = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32));
@@ -299,7 +310,8 @@ mod tests {
     /// Thirteen samples per pixel in one pass (through each pixel's cone, eight lanes then five), in thirteen
     /// passes of one (a full traversal and the one-sample estimator each) and in passes of three and ten give the
     /// same film bit for bit: on every bundled scene, with every registered strategy (the light strategies take
-    /// the eight-lane estimators), and with every light selection for the light strategies.
+    /// the eight-lane estimators), with every light selection for the light strategies, and with both
+    /// footprints.
     #[test]
     fn any_split_into_passes_gives_the_same_film() {
         let settings: Vec<RenderSettings> = Strategy::ALL
@@ -313,6 +325,11 @@ mod tests {
                     ..Default::default()
                 })
             })
+            .chain(Strategy::ALL.map(|strategy| RenderSettings {
+                strategy,
+                footprint: Footprint::Centre,
+                ..Default::default()
+            }))
             .collect();
         for (name, scene, camera) in every_bundled_scene(48, 36) {
             let scene = Arc::new(scene);
@@ -333,9 +350,10 @@ mod tests {
                 for passes in [&[13][..], &[3, 10], &[5, 8]] {
                     assert!(
                         film(passes).pixels == one_by_one.pixels,
-                        "{name}, {} ({}): passes {passes:?} differ from one sample at a time",
+                        "{name}, {} ({}, {}): passes {passes:?} differ from one sample at a time",
                         settings.strategy.name(),
-                        settings.light_selection.name()
+                        settings.light_selection.name(),
+                        settings.footprint.name()
                     );
                 }
             }

@@ -79,10 +79,11 @@ pub fn write_comparison(c: &Comparison, folder: &Path) -> Result<PathBuf, Snapsh
     }
     if c.series.iter().any(|s| !s.points.is_empty()) {
         let floor = c.reference.map_or(0.0, |r| r.noise_mse().sqrt());
-        let title = format!("{}: RMSE against the reference", a.scene_name);
+        let title = format!("{}, {} footprint: RMSE against the reference", a.scene_name, a.settings.footprint.name());
         write_convergence_png(&out.join("convergence.png"), &title, c.series, floor, Metric::Mse, "CPU seconds")?;
         let floor = c.reference.map_or(0.0, |r| r.noise_rel_mse().sqrt());
-        let title = format!("{}: relative RMSE against the reference", a.scene_name);
+        let title =
+            format!("{}, {} footprint: relative RMSE against the reference", a.scene_name, a.settings.footprint.name());
         write_convergence_png(
             &out.join("convergence-relative.png"),
             &title,
@@ -141,6 +142,7 @@ fn lane_json(f: &Frame, reference: Option<&Reference>) -> Value {
         "light_selection": f.settings.light_selection.name(),
         "mis": format!("{:?}", f.settings.mis),
         "seed": f.settings.seed,
+        "footprint": f.settings.footprint.name(),
         "spp": f.spp,
         "cpu_seconds": f.stats.cpu.as_secs_f64(),
         "wall_seconds": f.elapsed.as_secs_f64(),

@@ -18,7 +18,7 @@ mod reference_job;
 
 pub use frame::{Frame, ReferenceStatus};
 
-use crate::render::{Film, PixelCones, RenderSettings, Renderer};
+use crate::render::{Film, Footprint, PixelCones, RenderSettings, Renderer};
 use crate::scene::{Camera, Material, Scene};
 use lane::Lane;
 use reference_job::ReferenceJob;
@@ -228,6 +228,8 @@ struct State {
     job: Option<ReferenceJob>,
     /// The reference's generation, to discard a pass cancelled by a scene change.
     reference_generation: u64,
+    /// The footprint of the reference set up last: a lane with another restarts it.
+    reference_footprint: Footprint,
     /// Passes run: the reference gets every other one while lanes are busy.
     turn: u64,
     /// Per lane and reference: the generation of the last command received that restarts it.
@@ -275,6 +277,7 @@ impl State {
             reference_file: None,
             job: None,
             reference_generation: 0,
+            reference_footprint: Footprint::Jittered,
             turn: 0,
             received: [0; 3],
             latest,
@@ -457,7 +460,7 @@ impl State {
             }
         }
         let g = self.received[R];
-        if g != self.reference_generation {
+        if g != self.reference_generation || self.reference_footprint != self.lanes[A].settings.footprint {
             self.reference_generation = g;
             self.start_reference();
         }

@@ -1,7 +1,7 @@
 //! The reference as the worker renders it: from a file, from the cache, or pass by pass between the lanes' passes,
 //! then stored in the cache.
 
-use super::{ReferenceStatus, State};
+use super::{A, ReferenceStatus, State};
 use crate::measure::{Reference, ReferenceOrigin, load_cached, reference_settings, store_cached};
 use crate::render::{Film, Renderer};
 use std::path::PathBuf;
@@ -37,12 +37,15 @@ impl State {
             self.publish_reference(status);
             return;
         }
+        // The reference converges to what the lanes do: the box-filtered image or the pixel centres' values.
+        let footprint = self.lanes[A].settings.footprint;
+        self.reference_footprint = footprint;
         let Some(target) = self.reference_spp else {
             self.publish_reference(ReferenceStatus::Off);
             return;
         };
         if let Some(folder) = &self.reference_cache
-            && let Some(r) = load_cached(folder, &self.scene, target)
+            && let Some(r) = load_cached(folder, &self.scene, target, footprint)
         {
             let note = match &r.origin {
                 ReferenceOrigin::Cache(p) => format!("cached in {}", p.display()),
@@ -59,7 +62,7 @@ impl State {
             scratch: Film::new(w, h),
             spp: 0,
             elapsed: Duration::ZERO,
-            renderer: Renderer::new(self.scene.clone(), reference_settings()),
+            renderer: Renderer::new(self.scene.clone(), reference_settings(footprint)),
         });
         self.publish_reference(ReferenceStatus::Rendering { spp: 0, target, elapsed: Duration::ZERO });
     }
@@ -90,7 +93,7 @@ impl State {
         let Some(job) = self.job.take() else { return };
         let reference = Reference::from_film(&job.film, job.elapsed.as_secs_f64());
         let note = match &job.cache {
-            Some(folder) => match store_cached(folder, &self.scene, &reference) {
+            Some(folder) => match store_cached(folder, &self.scene, &reference, job.renderer.settings().footprint) {
                 Ok(p) => format!("rendered in {:.1} s, cached in {}", job.elapsed.as_secs_f64(), p.display()),
                 Err(e) => format!("rendered in {:.1} s, not cached: {e}", job.elapsed.as_secs_f64()),
             },
