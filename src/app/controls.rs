@@ -135,7 +135,12 @@ const MIS_DIRECTIONS: u32 = 4;
 
 fn sampling_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     ui.heading("Sampling");
-    let mut changed = ui.add(egui::Slider::new(&mut v.spp_per_pass, 1..=64).text("spp per pass")).changed();
+    let mut changed = ui
+        .checkbox(&mut v.auto_pass, "passes sized by time")
+        .on_hover_text("Each pass lasts 30–250 ms at the rate measured so far (the first one sample per pixel)")
+        .changed();
+    changed |=
+        ui.add_enabled(!v.auto_pass, egui::Slider::new(&mut v.spp_per_pass, 1..=64).text("spp per pass")).changed();
     ui.horizontal(|ui| {
         let mut limited = v.target_spp.is_some();
         changed |= ui.checkbox(&mut limited, "stop at").changed();

@@ -34,6 +34,8 @@ pub struct ViewOptions {
     pub plot: bool,
     /// Open the probe at this pixel.
     pub probe: Option<(u32, u32)>,
+    /// Threads that render passes (`None`: the default, see [`Viewer::with_scene`]).
+    pub threads: Option<usize>,
 }
 
 /// Opens the window, already rendering.
@@ -52,7 +54,7 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
         "illumlab",
         native,
         Box::new(move |cc| {
-            let mut viewer = Viewer::with_scene(std::sync::Arc::new(scene));
+            let mut viewer = Viewer::with_threads(std::sync::Arc::new(scene), options.threads);
             viewer.configure(options.settings, options.target_spp, options.exposure);
             viewer.set_reference_spp(options.reference_spp);
             viewer.set_budget(options.budget);

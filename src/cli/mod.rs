@@ -83,6 +83,9 @@ pub struct ViewArgs {
     pub strategy: Strategy,
     #[arg(long, default_value_t = 0, allow_negative_numbers = true)]
     pub seed: u64,
+    /// Threads that render passes (default: every core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
+    pub threads: Option<u32>,
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
     pub light_selection: LightSelection,
     /// Stop refining at this many samples per pixel.
@@ -240,6 +243,7 @@ pub fn run(command: Command) -> Result<()> {
             reference_spp: args.reference_spp,
             plot: args.plot,
             probe: args.probe,
+            threads: args.threads.map(|t| t as usize),
         }),
     }
 }

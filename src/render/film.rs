@@ -24,15 +24,6 @@ impl PixelAccum {
         self.max_luminance = self.max_luminance.max(luminance(v));
     }
 
-    /// Adds the samples accumulated in `other`.
-    #[inline]
-    pub fn merge(&mut self, other: &PixelAccum) {
-        self.sum += other.sum;
-        self.sum_sq += other.sum_sq;
-        self.n += other.n;
-        self.max_luminance = self.max_luminance.max(other.max_luminance);
-    }
-
     /// The pixel estimate: the sample mean.
     #[inline]
     pub fn mean(&self) -> DVec3 {

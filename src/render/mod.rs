@@ -15,6 +15,7 @@ pub use cones::PixelCones;
 pub use estimator::{SEGMENT_END, estimate_direct, reached, shadow_ray_ends, visible};
 pub use film::{Film, PixelAccum};
 pub use footprint::Footprint;
+pub use lanes::LANES;
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};
 pub use pass::{PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;

@@ -14,9 +14,11 @@
 
 mod frame;
 mod lane;
+mod pass_size;
 mod reference_job;
 
 pub use frame::{Frame, ReferenceStatus};
+pub use pass_size::PassSize;
 
 use crate::render::{Film, Footprint, PixelCones, RenderSettings, Renderer};
 use crate::scene::{Camera, Material, Scene};
@@ -67,7 +69,7 @@ pub enum Command {
         material: Material,
     },
     /// Samples per pixel taken in one pass (how often a frame is published).
-    SetSppPerPass(u32),
+    SetPassSize(PassSize),
     /// Stop refining at this many samples per pixel (`None`: never).
     SetTargetSpp(Option<u32>),
     Pause(bool),
@@ -128,7 +130,7 @@ struct Shared {
 }
 
 impl Worker {
-    /// Starts rendering `scene` at once. `threads`: size of the pass's thread pool (leave the UI a core).
+    /// Starts rendering `scene` at once. `threads`: size of the pass's thread pool.
     pub fn spawn(
         scene: Arc<Scene>,
         settings: RenderSettings,
@@ -218,7 +220,7 @@ struct State {
     budget: Budget,
     /// Equal time with a target: the CPU time the first lane needed to reach it.
     time_budget: Option<Duration>,
-    spp_per_pass: u32,
+    pass_size: PassSize,
     target: Option<u32>,
     paused: bool,
     /// What the reference should be: the spp to render and where to cache it, or a file.
@@ -269,7 +271,7 @@ impl State {
             comparing: false,
             budget: Budget::EqualSamples,
             time_budget: None,
-            spp_per_pass: 1,
+            pass_size: PassSize::Auto,
             target: None,
             paused: false,
             reference_spp: None,
@@ -429,7 +431,7 @@ impl State {
                     *m = material;
                 }
             }
-            Command::SetSppPerPass(n) => self.spp_per_pass = n.max(1),
+            Command::SetPassSize(size) => self.pass_size = size,
             Command::SetTargetSpp(t) => {
                 self.target = t;
                 self.time_budget = None;
@@ -520,9 +522,10 @@ impl State {
     fn pass(&mut self, i: usize, pool: &rayon::ThreadPool) {
         let equal_time = self.comparing && self.budget == Budget::EqualTime;
         let lane = &mut self.lanes[i];
+        let count = self.pass_size.count(lane.passes, lane.spp, lane.elapsed);
         let count = match self.target {
-            Some(t) if !equal_time => self.spp_per_pass.min(t.saturating_sub(lane.spp)).max(1),
-            _ => self.spp_per_pass,
+            Some(t) if !equal_time => count.min(t.saturating_sub(lane.spp)).max(1),
+            _ => count,
         };
         let generation = lane.generation;
         let current = &self.shared.resets[i];

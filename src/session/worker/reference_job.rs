@@ -14,7 +14,8 @@ pub(super) struct ReferenceJob {
     target: u32,
     cache: Option<PathBuf>,
     film: Film,
-    /// One pass's samples, merged into `film` when the pass completes.
+    /// `film` and one more pass's samples, added sample by sample as a one-shot render adds them (so the
+    /// reference does not depend on how its passes were sized); it replaces `film` when the pass completes.
     scratch: Film,
     spp: u32,
     elapsed: Duration,
@@ -67,24 +68,23 @@ impl State {
         self.publish_reference(ReferenceStatus::Rendering { spp: 0, target, elapsed: Duration::ZERO });
     }
 
-    /// One sample per pixel into a scratch film, merged into the reference only if no command arrived meanwhile
-    /// (so a reference pass never delays a new setting by more than a row).
+    /// A pass sized as the lanes' are ([`super::PassSize`]) onto a copy of the reference, kept only if no command
+    /// arrived meanwhile (so a reference pass never delays a new setting by more than a row).
     pub(super) fn reference_pass(&mut self, pool: &rayon::ThreadPool) {
         let Some(job) = &mut self.job else { return };
         let generation = self.shared.generation.load(Ordering::SeqCst);
         let current = &self.shared.generation;
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
-        job.scratch.clear();
+        job.scratch.pixels.clone_from(&job.film.pixels);
+        let count = self.pass_size.count(job.spp.min(1), job.spp, job.elapsed).min(job.target - job.spp);
         let start = Instant::now();
-        pool.install(|| job.renderer.render_pass(&mut job.scratch, job.spp, 1, &cancelled));
+        pool.install(|| job.renderer.render_pass(&mut job.scratch, job.spp, count, &cancelled));
         if cancelled() {
             return;
         }
         job.elapsed += start.elapsed();
-        job.spp += 1;
-        for (acc, s) in job.film.pixels.iter_mut().zip(&job.scratch.pixels) {
-            acc.merge(s);
-        }
+        job.spp += count;
+        std::mem::swap(&mut job.film, &mut job.scratch);
         if job.spp < job.target {
             let status = ReferenceStatus::Rendering { spp: job.spp, target: job.target, elapsed: job.elapsed };
             self.publish_reference(status);

@@ -65,7 +65,7 @@ fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
     let scene = small_scene();
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
     worker.send(Command::SetTargetSpp(Some(5)));
-    worker.send(Command::SetSppPerPass(2));
+    worker.send(Command::SetPassSize(PassSize::Fixed(2)));
     let f = wait_for(&worker, |f| f.spp == 5);
     std::thread::sleep(Duration::from_millis(50));
     assert!(worker.take_frame().is_none(), "idle at the target");
@@ -73,6 +73,21 @@ fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
     let mut film = Film::new(32, 32);
     Renderer::new(scene, RenderSettings::default()).render_pass(&mut film, 0, 5, &|| false);
     assert_eq!(f.radiance, film.means());
+}
+
+/// By default passes are sized by time (the first takes one sample per pixel: `pass_size`'s unit test): later
+/// ones take many more (a 32² box renders hundreds of spp in 30 ms), and the film is still a one-shot render's,
+/// bit for bit.
+#[test]
+fn auto_passes_grow_from_one_sample_and_give_the_one_shot_image() {
+    let scene = small_scene();
+    let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
+    worker.send(Command::SetTargetSpp(Some(2000)));
+    let done = wait_for(&worker, |f| f.spp == 2000);
+    assert!(done.passes < 200, "{} passes for 2000 spp: they grew", done.passes);
+    let mut film = Film::new(32, 32);
+    Renderer::new(scene, RenderSettings::default()).render_pass(&mut film, 0, 2000, &|| false);
+    assert_eq!(done.radiance, film.means());
 }
 
 /// Passes of 4 spp go through the pixel cones, which the worker keeps from pass to pass and finds again when the
@@ -86,7 +101,7 @@ fn kept_pixel_cones_give_the_one_shot_image_and_follow_the_camera() {
         film.means()
     };
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
-    worker.send(Command::SetSppPerPass(4));
+    worker.send(Command::SetPassSize(PassSize::Fixed(4)));
     worker.send(Command::SetTargetSpp(Some(12)));
     let f = wait_for(&worker, |f| f.spp == 12);
     assert_eq!(f.passes, 3);
@@ -120,7 +135,7 @@ fn equal_time_gives_both_lanes_the_same_cpu_time() {
     let worker = Worker::spawn(small_scene(), settings(Strategy::Cosine), 1, || {});
     worker.send(Command::SetCompare(Some(settings(Strategy::ProjectedSolidAngle))));
     worker.send(Command::SetBudget(Budget::EqualTime));
-    worker.send(Command::SetSppPerPass(4));
+    worker.send(Command::SetPassSize(PassSize::Fixed(4)));
     worker.send(Command::SetTargetSpp(Some(400)));
     let a = wait_for_lane(&worker, A, |f| f.spp >= 400);
     let b = wait_for_lane(&worker, B, |f| f.stats.cpu >= a.stats.cpu);
