@@ -40,6 +40,9 @@ shoot_compare() { # name warm-up-seconds seconds scene args…
 }
 shoot_compare split 45 25 veach-mis --strategy emitter --compare brdf --target-spp 256 --reference-spp 256 --plot
 shoot_compare errors 1 15 cornell-box --strategy emitter --compare cosine --view std-error --target-spp 64 --exposure 1
+# Fixed primary hits: the standard error is the estimators' own, and solid-angle sampling's is lower under the
+# light than emitter sampling's (1/r²).
+shoot_compare fixed-hits 50 20 near-light --strategy emitter --compare solid-angle --footprint centre --view std-error --target-spp 256 --reference-spp 256 --plot --exposure -2
 shoot_compare plot 50 30 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2
 shoot_probe() { # name seconds scene args…
   local out="screenshots/viewer-probe-$1.png" wait=$2 scene=$3; shift 3

@@ -86,6 +86,10 @@ pub struct ViewArgs {
     /// Threads that render passes (default: every core).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub threads: Option<u32>,
+    /// Where camera rays go in their pixels: jittered (pictures) or centre (fixed primary hits: the error maps and
+    /// the convergence plot show the estimators' own error; the reference is rendered the same way).
+    #[arg(long, value_parser = parse_footprint, default_value = "jittered")]
+    pub footprint: Footprint,
     #[arg(long, value_parser = parse_light_selection, default_value = "power")]
     pub light_selection: LightSelection,
     /// Stop refining at this many samples per pixel.
@@ -232,7 +236,7 @@ pub fn run(command: Command) -> Result<()> {
                 light_selection: args.light_selection,
                 seed: args.seed,
                 mis: args.mis.settings(),
-                footprint: Footprint::Jittered,
+                footprint: args.footprint,
             },
             target_spp: args.target_spp,
             exposure: args.exposure,
