@@ -76,8 +76,14 @@ impl Viewer {
         if frame.lane == B && series_label(&frame.settings) == series_label(&self.settings) {
             return;
         }
+        // The estimator's own error: the reference's noise is subtracted, as the bench subtracts it.
         let metrics = error_vs_reference(&frame.radiance, &reference);
-        let point = ConvergencePoint::new(frame.spp, frame.stats.cpu.as_secs_f64(), &metrics);
+        let point = ConvergencePoint {
+            spp: frame.spp,
+            seconds: frame.stats.cpu.as_secs_f64(),
+            mse: metrics.estimator_mse(),
+            rel_mse: metrics.estimator_rel_mse(),
+        };
         let label = series_label(&frame.settings);
         let series = match self.history.iter().position(|s| s.label == label) {
             Some(i) => &mut self.history[i],

@@ -33,7 +33,10 @@ pub fn convergence_window(v: &mut Viewer, ui: &mut egui::Ui) {
             ui.radio_value(&mut v.plot_relative, false, "RMSE");
             ui.radio_value(&mut v.plot_relative, true, "relative RMSE, sqrt(relMSE)");
         });
-        ui.label(format!("Measured with {}.", v.settings.footprint.description()));
+        ui.label(format!(
+            "Measured with {}; the reference's own noise (dotted) is subtracted.",
+            v.settings.footprint.description()
+        ));
         ui.small(if v.plot_relative {
             "Each pixel's error relative to its brightness: dark regions count as much as visible lights."
         } else {
@@ -119,7 +122,7 @@ fn plot(ui: &mut egui::Ui, id: &str, labels: (&str, &str), series: &[Series], fl
             );
         }
         if floor > 0.0 {
-            plot.hline(HLine::new("reference noise", log(floor)).style(LineStyle::dotted_dense()));
+            plot.hline(HLine::new("reference noise (subtracted)", log(floor)).style(LineStyle::dotted_dense()));
         }
     });
 }

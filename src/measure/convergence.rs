@@ -3,7 +3,6 @@
 //! against spp and against time; estimators differ by the height of that line, which is what efficiency
 //! `1/(MSE · seconds)` measures.
 
-use super::ErrorMetrics;
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -15,25 +14,22 @@ pub struct ConvergencePoint {
 }
 
 impl ConvergencePoint {
-    pub fn new(spp: u32, seconds: f64, metrics: &ErrorMetrics) -> Self {
-        Self { spp, seconds, mse: metrics.mse, rel_mse: metrics.rel_mse }
-    }
-
     pub fn rmse(&self) -> f64 {
         self.mse.sqrt()
     }
 
-    /// `1/(MSE · seconds)`, `None` when not finite.
+    /// `1/(MSE · seconds)`, `None` when not finite or not positive (an MSE with the reference's noise
+    /// subtracted can come out at or below 0).
     pub fn efficiency(&self) -> Option<f64> {
         let e = 1.0 / (self.mse * self.seconds);
-        e.is_finite().then_some(e)
+        (e.is_finite() && e > 0.0).then_some(e)
     }
 
     /// `1/(relMSE · seconds)`: the same with every pixel's error relative to its brightness, so that dark regions
     /// count as much as visible lights.
     pub fn rel_efficiency(&self) -> Option<f64> {
         let e = 1.0 / (self.rel_mse * self.seconds);
-        e.is_finite().then_some(e)
+        (e.is_finite() && e > 0.0).then_some(e)
     }
 }
 
