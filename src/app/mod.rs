@@ -5,6 +5,7 @@ mod compare_mode;
 mod controls;
 mod convergence;
 mod files;
+mod frames;
 mod loader;
 mod orbit;
 mod probe;

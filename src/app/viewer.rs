@@ -5,9 +5,9 @@ use super::orbit;
 use crate::measure::{ColorScale, Series, default_cache_folder};
 use crate::render::{Footprint, RenderSettings, Strategy};
 use crate::scene::{Camera, Material, Scene};
-use crate::session::snapshot::{display_rgba, write_snapshot};
-use crate::session::views::{View, shared_scale, unavailable, view_values};
-use crate::session::worker::{A, B, Budget, Command, Frame, PassSize, ReferenceStatus, Worker};
+use crate::session::snapshot::write_snapshot;
+use crate::session::views::View;
+use crate::session::worker::{Budget, Command, Frame, PassSize, ReferenceStatus, Worker};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -57,14 +57,14 @@ pub struct Viewer {
     /// Where the image (A's, in compare mode) was last drawn, in points.
     pub(super) image_rect: Option<egui::Rect>,
     /// Textures of lanes A and B.
-    textures: [Option<egui::TextureHandle>; 2],
+    pub(super) textures: [Option<egui::TextureHandle>; 2],
     /// The textures must be refilled (a restarted image, view or exposure).
     pub(super) texture_stale: bool,
-    /// A refined frame of the image shown waits for its upload ([`UPLOAD_INTERVAL`]).
-    refined: bool,
+    /// A refined frame of the image shown waits for its upload ([`super::frames::UPLOAD_INTERVAL`]).
+    pub(super) refined: bool,
     /// Set from a restart to its first frame: the worker's notices repaint at once meanwhile.
-    awaiting_frame: Arc<AtomicBool>,
-    last_upload: Option<Instant>,
+    pub(super) awaiting_frame: Arc<AtomicBool>,
+    pub(super) last_upload: Option<Instant>,
     pub(super) loading: Option<Loading>,
     pub(super) error: Option<String>,
     pub(super) message: Option<String>,
@@ -73,7 +73,7 @@ pub struct Viewer {
     pub(super) show_help: bool,
     pub(super) hide_panels: bool,
     /// When the last restart was requested, and the generation that answers it.
-    restart_sent: Option<(Instant, u64)>,
+    pub(super) restart_sent: Option<(Instant, u64)>,
     /// Time from the last restart request to its first frame on screen.
     pub(super) restart_latency: Option<Duration>,
     /// Recent UI frame times (for the status bar).
@@ -105,12 +105,12 @@ impl Viewer {
         // Until the first frame of a new setting arrives the worker's news repaints at once; refinements after it
         // wait for the next upload.
         let awaiting_frame = Arc::new(AtomicBool::new(true));
-        let notify = frame_notifier(&repaint, awaiting_frame.clone());
+        let notify = super::frames::frame_notifier(&repaint, awaiting_frame.clone());
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let threads = threads.unwrap_or(cores).max(1);
         let settings = RenderSettings::default();
         let worker = Worker::spawn(scene.clone(), settings, threads, notify);
-        let probe = super::probe::ProbeUi::new(notifier(&repaint));
+        let probe = super::probe::ProbeUi::new(super::frames::notifier(&repaint));
         let camera = scene.camera;
         let mut viewer = Self {
             worker,
@@ -265,102 +265,6 @@ impl Viewer {
         }
     }
 
-    /// The newest frames and reference from the worker, if any; records convergence; refreshes textures lazily.
-    fn take_frames(&mut self) {
-        if let Some(failure) = self.worker.take_failure() {
-            self.error = Some(failure);
-        }
-        if let Some(status) = self.worker.take_reference() {
-            // Progress reports of the same render change neither the runs nor the maps.
-            let progress = matches!(
-                (&self.reference, &status),
-                (ReferenceStatus::Rendering { .. }, ReferenceStatus::Rendering { .. })
-            );
-            if !progress {
-                self.history.clear();
-                self.texture_stale = true;
-            }
-            self.reference = status;
-        }
-        for lane in [A, B] {
-            let Some(frame) = self.worker.take_lane(lane) else { continue };
-            if lane == B && !self.comparing {
-                continue; // a frame from before compare mode was left
-            }
-            if let Some((sent, generation)) = self.restart_sent
-                && frame.generation >= generation
-            {
-                self.restart_latency = Some(sent.elapsed());
-                self.restart_sent = None;
-                if self.trace {
-                    let ms = sent.elapsed().as_secs_f64() * 1e3;
-                    eprintln!("trace: restart-to-frame {ms:.1} ms at {}x{}", frame.width, frame.height);
-                }
-            }
-            if self.restart_sent.is_none() {
-                self.awaiting_frame.store(false, Ordering::Relaxed);
-            }
-            self.record(&frame);
-            let shown = if lane == A { &mut self.frame } else { &mut self.frame_b };
-            // A refinement of the image on screen may wait for the next upload; anything else shows at once.
-            let refinement = shown.as_ref().is_some_and(|f| f.generation == frame.generation && !f.preview);
-            *shown = Some(frame);
-            if refinement {
-                self.refined = true;
-            } else {
-                self.texture_stale = true;
-            }
-        }
-    }
-
-    /// The textures of A (and B when comparing) in the current view and exposure, updated in place.
-    pub(super) fn textures(&mut self, ctx: &egui::Context) -> [Option<egui::TextureId>; 2] {
-        let frames = [self.frame.clone(), self.frame_b.clone().filter(|_| self.comparing)];
-        if self.refined {
-            match self.last_upload.map(|t| t.elapsed()) {
-                Some(since) if since < UPLOAD_INTERVAL => ctx.request_repaint_after(UPLOAD_INTERVAL - since),
-                _ => self.texture_stale = true,
-            }
-        }
-        if self.texture_stale || self.textures[A].is_none() {
-            self.texture_stale = false;
-            self.refined = false;
-            self.last_upload = Some(Instant::now());
-            let reference = self.reference().cloned();
-            let reference = reference.as_deref();
-            let values: Vec<Option<Vec<f32>>> = [A, B]
-                .map(|i| {
-                    let f = frames[i].as_deref()?;
-                    view_values(self.view, f, reference, frames[1 - i].as_deref())
-                })
-                .into();
-            let shown: Vec<&[f32]> = values.iter().flatten().map(|v| v.as_slice()).collect();
-            self.scale = shared_scale(&shown);
-            self.view_note =
-                frames[A].as_deref().and_then(|f| unavailable(self.view, f, reference, frames[B].as_deref()));
-            if self.view_note.is_none() && self.view != View::Image && self.scale.is_none() {
-                self.view_note = Some("zero everywhere");
-            }
-            for i in [A, B] {
-                let Some(frame) = frames[i].as_deref() else { continue };
-                let rgba = match (&values[i], self.scale) {
-                    (Some(v), Some(scale)) if self.view_note.is_none() => scale.colorize(v),
-                    _ => display_rgba(&frame.radiance, self.exposure),
-                };
-                let image =
-                    egui::ColorImage::from_rgba_unmultiplied([frame.width as usize, frame.height as usize], &rgba);
-                match &mut self.textures[i] {
-                    Some(t) => t.set(image, egui::TextureOptions::NEAREST),
-                    None => {
-                        self.textures[i] =
-                            Some(ctx.load_texture(["lane A", "lane B"][i], image, egui::TextureOptions::NEAREST))
-                    }
-                }
-            }
-        }
-        [A, B].map(|i| frames[i].as_ref().and(self.textures[i].as_ref()).map(|t| t.id()))
-    }
-
     pub(super) fn set_exposure(&mut self, stops: f32) {
         self.exposure = stops.clamp(-20.0, 20.0);
         self.texture_stale = true;
@@ -442,7 +346,7 @@ impl Viewer {
     /// Starts loading a bundled scene or a file in the background; the current scene stays until it succeeds.
     /// Wakes the UI from another thread (a dialog's, a loader's).
     pub(super) fn waker(&self) -> impl Fn() + Send + 'static {
-        notifier(&self.repaint)
+        super::frames::notifier(&self.repaint)
     }
 
     pub(super) fn open(&mut self, what: String) {
@@ -502,41 +406,5 @@ impl Viewer {
         let size = if self.auto_pass { PassSize::Auto } else { PassSize::Fixed(self.spp_per_pass) };
         self.worker.send(Command::SetPassSize(size));
         self.worker.send(Command::SetTargetSpp(self.target_spp));
-    }
-}
-
-/// Refined frames of the image on screen are uploaded at most this often: on a software rasteriser (a VM, Xvfb) an
-/// upload and repaint per pass would take the core that renders. A restart, a new view or exposure shows at once.
-const UPLOAD_INTERVAL: Duration = Duration::from_millis(250);
-
-/// The worker's callback: a repaint at once while `awaiting` (a new setting's first frame), else within
-/// [`UPLOAD_INTERVAL`], when the refined frame is uploaded anyway.
-fn frame_notifier(
-    repaint: &Arc<Mutex<Option<egui::Context>>>,
-    awaiting: Arc<AtomicBool>,
-) -> impl Fn() + Send + 'static {
-    let target = repaint.clone();
-    move || {
-        if let Ok(ctx) = target.lock()
-            && let Some(ctx) = ctx.as_ref()
-        {
-            if awaiting.load(Ordering::Relaxed) {
-                ctx.request_repaint();
-            } else {
-                ctx.request_repaint_after(UPLOAD_INTERVAL);
-            }
-        }
-    }
-}
-
-/// A callback for other threads that asks the bound context, if any, to repaint.
-fn notifier(repaint: &Arc<Mutex<Option<egui::Context>>>) -> impl Fn() + Send + 'static {
-    let target = repaint.clone();
-    move || {
-        if let Ok(ctx) = target.lock()
-            && let Some(ctx) = ctx.as_ref()
-        {
-            ctx.request_repaint();
-        }
     }
 }

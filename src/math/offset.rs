@@ -170,7 +170,7 @@ mod tests {
     /// in front of the triangle to them, their far ends offset, stop short of it.
     #[test]
     fn offset_points_never_see_their_own_triangle() {
-        use crate::scene::accel::test_ray_triangle;
+        use crate::scene::test_ray_triangle;
         let mut rng = SampleRng::new(11, 0, 0);
         let mut tested = 0;
         for k in 0..200_000 {

@@ -1,7 +1,7 @@
 //! Scenes: triangles with Phong materials, emissive triangles as area lights, a pinhole camera and a BVH.
 //! Loaded from a TOML scene file that lists OBJ/MTL meshes, or built directly (tests, analytic scenes).
 
-pub(crate) mod accel;
+mod accel;
 mod bundled;
 mod camera;
 mod convex;
@@ -13,6 +13,8 @@ mod material;
 mod mtl;
 
 pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
+#[cfg(test)]
+pub(crate) use accel::test_ray_triangle;
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};

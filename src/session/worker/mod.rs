@@ -12,16 +12,18 @@
 //! same time within one pass and each shows its own spp. With a target spp, equal time stops each lane at the CPU
 //! time the first one needed to reach the target.
 
+mod command;
 mod frame;
 mod lane;
 mod pass_size;
 mod reference_job;
 
+pub use command::{Budget, Command};
 pub use frame::{Frame, ReferenceStatus};
 pub use pass_size::PassSize;
 
 use crate::render::{Film, Footprint, PixelCones, RenderSettings, Renderer};
-use crate::scene::{Camera, Material, Scene};
+use crate::scene::{Camera, Scene};
 use lane::Lane;
 use reference_job::ReferenceJob;
 use std::path::PathBuf;
@@ -36,71 +38,6 @@ pub const A: usize = 0;
 pub const B: usize = 1;
 /// The reference's index among the generation counters.
 const R: usize = 2;
-
-/// How compare mode shares the integrator between A and B.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Budget {
-    #[default]
-    EqualSamples,
-    EqualTime,
-}
-
-impl Budget {
-    pub fn name(self) -> &'static str {
-        match self {
-            Budget::EqualSamples => "equal samples",
-            Budget::EqualTime => "equal time",
-        }
-    }
-}
-
-/// What the UI can ask of the worker.
-pub enum Command {
-    /// Render another scene (its camera included).
-    SetScene(Arc<Scene>),
-    /// Lane A's settings.
-    SetSettings(RenderSettings),
-    /// Compare mode: lane B's settings; `None` renders A alone.
-    SetCompare(Option<RenderSettings>),
-    SetBudget(Budget),
-    SetCamera(Camera),
-    SetMaterial {
-        index: usize,
-        material: Material,
-    },
-    /// Samples per pixel taken in one pass (how often a frame is published).
-    SetPassSize(PassSize),
-    /// Stop refining at this many samples per pixel (`None`: never).
-    SetTargetSpp(Option<u32>),
-    Pause(bool),
-    /// Discard the films and start again (the reference stays).
-    Restart,
-    /// Render a reference at this many spp (or take it from the cache folder, and store it there when done);
-    /// `None` forgets the reference.
-    SetReference {
-        spp: Option<u32>,
-        cache: Option<PathBuf>,
-    },
-    /// Use the reference in this EXR file (with its `.var.exr` sibling if present).
-    LoadReference(PathBuf),
-    Quit,
-    /// Tests: the next pass panics.
-    #[cfg(test)]
-    PanicInNextPass,
-}
-
-impl Command {
-    /// The generation counters the command bumps: lanes and reference whose image it changes.
-    fn resets(&self) -> &'static [usize] {
-        match self {
-            Command::SetScene(_) | Command::SetCamera(_) | Command::SetMaterial { .. } => &[A, B, R],
-            // A change to either lane restarts both: under equal time they must start from zero CPU time together.
-            Command::Restart | Command::SetBudget(_) | Command::SetSettings(_) | Command::SetCompare(_) => &[A, B],
-            Command::SetReference { .. } | Command::LoadReference(_) => &[R],
-            _ => &[],
-        }
-    }
-}
 
 /// Handle to the integrator thread; dropping it stops the thread.
 pub struct Worker {
