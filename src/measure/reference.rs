@@ -90,27 +90,13 @@ impl Reference {
     /// The reference's own noise: the mean over pixels and channels of `σ̂²/N`, in squared radiance. 0 when
     /// unknown.
     pub fn noise_mse(&self) -> f64 {
-        let Some(var) = &self.var_of_mean else { return 0.0 };
-        if var.is_empty() {
-            return 0.0;
-        }
-        var.iter().map(|v| v.as_dvec3().element_sum()).sum::<f64>() / (3 * var.len()) as f64
+        super::error_over(&self.mean, self, None).reference_mse
     }
 
     /// The reference's own noise relative to its brightness: the mean of `(σ̂²/N) / (R² + ε)` (see relMSE in
     /// [`super::error_vs_reference`]). 0 when unknown.
     pub fn noise_rel_mse(&self) -> f64 {
-        let Some(var) = &self.var_of_mean else { return 0.0 };
-        if var.is_empty() {
-            return 0.0;
-        }
-        let eps = glam::DVec3::splat(super::REL_MSE_EPSILON);
-        let sum: f64 = var
-            .iter()
-            .zip(&self.mean)
-            .map(|(v, m)| (v.as_dvec3() / (m.as_dvec3() * m.as_dvec3() + eps)).element_sum())
-            .sum();
-        sum / (3 * var.len()) as f64
+        super::error_over(&self.mean, self, None).reference_rel_mse
     }
 
     /// Reads an EXR's first RGB(A) layer; a sibling `<stem>.var.exr`, if present, gives the variance of the mean.

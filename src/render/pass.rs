@@ -174,8 +174,11 @@ impl Renderer {
                         }
                     }
                 } else {
-                    let cones = self.cones.row(&self.scene, &self.camera, y as u32, width);
-                    for ((x, acc), cone) in row.iter_mut().enumerate().zip(cones) {
+                    // Through the pixel centres every sample shares one ray: no cone is needed (see below).
+                    let mut cones = (self.settings.footprint == Footprint::Jittered)
+                        .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
+                    for (x, acc) in row.iter_mut().enumerate() {
+                        let cone = cones.as_mut().and_then(|c| c.next()).flatten();
                         let streams = streams(x);
                         for group in (first..first + count).step_by(LANES) {
                             let samples = group..(group + LANES as u32).min(first + count);

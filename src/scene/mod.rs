@@ -12,9 +12,9 @@ mod load;
 mod material;
 mod mtl;
 
-pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
+pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
