@@ -153,7 +153,7 @@ fn rays(c: &mut Criterion) {
         // The integrator, on one thread like the rays above: every ray it traces (camera and shadow rays), with its
         // sampling and shading around them, in passes of 32 samples per pixel over the scene's own image.
         const SPP: u32 = 32;
-        let renderer = Renderer::new(
+        let mut renderer = Renderer::new(
             std::sync::Arc::new(scene.clone()),
             RenderSettings { strategy: Strategy::Emitter, ..Default::default() },
         );
@@ -195,7 +195,7 @@ fn ratio_rounds() {
             black_box(n);
             (work.primary.len() + work.shadow.len()) as f64 / cpu.elapsed().as_secs_f64()
         };
-        let renderer = Renderer::new(
+        let mut renderer = Renderer::new(
             std::sync::Arc::new(scene.clone()),
             RenderSettings { strategy: Strategy::Emitter, ..Default::default() },
         );

@@ -18,7 +18,7 @@ fn strategies(c: &mut Criterion) {
         for strategy in Strategy::ALL {
             let settings =
                 RenderSettings { strategy, light_selection: LightSelection::Power, seed: 0, ..Default::default() };
-            let renderer = Renderer::new(std::sync::Arc::new(scene.clone()), settings);
+            let mut renderer = Renderer::new(std::sync::Arc::new(scene.clone()), settings);
             let mut film = Film::new(128, 128);
             let mut first = 0;
             group.bench_function(strategy.name(), |b| {

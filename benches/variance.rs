@@ -47,7 +47,7 @@ fn table(scene_name: &str, size: (u32, u32), spp: u32, materials: &[&str], colum
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
     for (name, mut s) in settings() {
         s.light_selection = LightSelection::Power;
-        let renderer = Renderer::new(std::sync::Arc::new(scene.clone()), s);
+        let mut renderer = Renderer::new(std::sync::Arc::new(scene.clone()), s);
         let mut film = Film::new(w, h);
         let start = Instant::now();
         let stats = pool.install(|| renderer.render_pass(&mut film, 0, spp, &|| false));

@@ -432,7 +432,113 @@ def near_light():
 
 
 # ----------------------------------------------------------------------------------------------------------------
-# 4. default
+# 4. occluded-light
+
+def occluded_light():
+    # A closed 6 x 6 m room, 1 m high, with an opaque ceiling pierced by one 0.2 m square hole in its middle; a
+    # 2 m square light 1 m above the ceiling (y = 2), facing down, shines into the room only through the hole.
+    # Seen from the floor under the hole, the hole projects onto the light's plane as a 0.4 m square: 0.16 of the
+    # light's 4 m^2, so 96% of emitter samples (and of MIS's light samples) hit the ceiling's top; cosine/BRDF
+    # sampling finds the hole with probability Omega_perp(hole) / pi ~ 1.3%. A learned guide (path guiding),
+    # which concentrates its samples on the hole, wins. A glossy box stands at the edge of the lit patch.
+    # Radiance: the floor under the hole gets E = Ke * Omega_perp(hole) ~ Ke * 0.04 sr (hole 0.2 m square, 1 m
+    # up), so L_o = k_d / pi * E ~ 0.0063 Ke with k_d = 0.5; Ke = 80 puts it near 0.5 at exposure 0, as the
+    # default scene's ramps.
+    half_room, height = 3.0, 1.0  # walls at x, z = +-3, ceiling at y = 1
+    hole = 0.1  # half-side of the ceiling's hole, centred at (0, 1, 0)
+    light_y, light_half, ke = 2.0, 1.0, 80.0
+    floor = Material("floor", kd=(0.5, 0.5, 0.5), comment="diffuse floor")
+    ceiling = Material("ceiling", kd=(0.5, 0.5, 0.5), comment="diffuse ceiling (opaque; a 0.2 m square hole in it)")
+    wall = Material("wall", kd=(0.5, 0.5, 0.5), comment="diffuse walls (back and front)")
+    red = Material("red", kd=(0.6, 0.3, 0.3), comment="diffuse reddish wall (x = -3)")
+    green = Material("green", kd=(0.3, 0.6, 0.3), comment="diffuse greenish wall (x = +3)")
+    glossy = Material("glossy", kd=(0.2, 0.2, 0.2), ks=(0.5, 0.5, 0.5), ns=30.0,
+                      comment="glossy Phong box (alpha 30)")
+    light = Material("light", ke=(ke, ke, ke),
+                     comment="2 m x 2 m light 1 m above the ceiling, facing down; floor under the hole ~ 0.5")
+
+    m = Mesh()
+    inside = (0.0, 0.5 * height, 0.0)
+    r, h = half_room, height
+    m.begin("floor", floor.name)
+    m.rect((0.0, 0.0, 0.0), (0.0, 0.0, r), (r, 0.0, 0.0))  # (0,0,r) x (r,0,0) = (0,r^2,0): up
+    walls = [
+        ("back_wall", wall, [(-r, 0.0, -r), (r, 0.0, -r), (r, h, -r), (-r, h, -r)]),
+        ("front_wall", wall, [(-r, 0.0, r), (r, 0.0, r), (r, h, r), (-r, h, r)]),
+        ("left_wall", red, [(-r, 0.0, -r), (-r, 0.0, r), (-r, h, r), (-r, h, -r)]),
+        ("right_wall", green, [(r, 0.0, -r), (r, 0.0, r), (r, h, r), (r, h, -r)]),
+    ]
+    for name, mat, ps in walls:
+        m.begin(name, mat.name)
+        m.quad_facing(ps, sub(inside, centroid(ps)))  # normals into the room
+    # Ceiling: a picture frame of four trapezoids, each from one outer edge to the matching edge of the hole (no
+    # T-junctions: every edge is shared whole), facing down into the room.
+    outer = [(-r, h, -r), (r, h, -r), (r, h, r), (-r, h, r)]
+    inner = [(-hole, h, -hole), (hole, h, -hole), (hole, h, hole), (-hole, h, hole)]
+    m.begin("ceiling", ceiling.name)
+    for i in range(4):
+        j = (i + 1) % 4
+        m.quad_facing([outer[i], outer[j], inner[j], inner[i]], (0.0, -1.0, 0.0))
+    m.begin("box", glossy.name)
+    box_c, box_half = (0.5, 0.15, 0.3), 0.15
+    m.box(box_c, (box_half, 0.0, 0.0), (0.0, 0.0, box_half), (0.0, box_half, 0.0))
+    m.begin("light", light.name)
+    m.rect((0.0, light_y, 0.0), (light_half, 0.0, 0.0), (0.0, 0.0, light_half))  # (1,0,0) x (0,0,1): down
+
+    # From a floor point p, a line through the hole (y = h) meets the light's plane at p + (q - p) * k, k = y_l / h:
+    # the hole's image there is a square of half-side hole * k centred at p * (1 - k).
+    k = light_y / h
+    img_half = hole * k
+    visible = (2.0 * img_half) ** 2 / (2.0 * light_half) ** 2  # from (0, 0, 0); the image lies inside the light
+    assert img_half <= light_half
+    hole_poly = inner
+    o_hole = polygon_projected_solid_angle((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), hole_poly)
+    lo_hole = floor.kd[0] / math.pi * ke * o_hole
+    plateau = (light_half - img_half) / (k - 1.0)  # |x|, |z| below this: the whole hole shows the light
+    reach = (light_half + img_half) / (k - 1.0)  # beyond this: no light at all
+
+    eye, target = (0.0, 0.85, 2.6), (0.0, 0.1, 0.0)
+    scene = Scene(
+        "occluded-light",
+        "A closed 6 x 6 m room, 1 m high, whose opaque ceiling has one 0.2 m square hole in its middle; a 2 m "
+        "square light 1 m above the ceiling, facing down, lights the room only through the hole. From the floor "
+        f"under the hole only {100.0 * visible:g}% of the light's area is visible (the hole projects onto the "
+        f"light's plane as a {2.0 * img_half:g} m square: {(2.0 * img_half) ** 2:g} of {(2.0 * light_half) ** 2:g} "
+        "m^2), so emitter sampling and MIS lose almost every shadow ray, and cosine/BRDF sampling finds the hole "
+        f"with probability {100.0 * o_hole / math.pi:.1f}%; a learned guide (path guiding) wins. A glossy box "
+        f"(Phong alpha 30) stands at the edge of the lit patch. Light Ke = {ke:g}: the floor under the hole has "
+        f"radiance {lo_hole:.2f} (k_d = 0.5). The light is above the ceiling, out of the camera's sight.",
+        dict(eye=eye, target=target, up=(0.0, 1.0, 0.0), fov_y=55.0, width=256, height=256),
+        m, [floor, ceiling, wall, red, green, glossy, light])
+    scene.light_checks["light"] = ("light faces down towards the hole (n.y < 0)", lambda n, c: n[1] < -0.999)
+    scene.probes = [("floor under the hole, as if there were no ceiling", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0),
+                     floor.kd)]
+
+    # Geometric checks: the eye is inside the room and cannot see the light (its view through the hole, projected
+    # onto the light's plane, misses the light); the box stands on the floor inside the lit patch's reach.
+    assert all(abs(eye[i]) < r for i in (0, 2)) and 0.0 < eye[1] < h
+    s = (light_y - eye[1]) / (h - eye[1])
+    seen = [add(eye, mul(sub(q, eye), s)) for q in hole_poly]  # the hole's image on the light's plane, from the eye
+    lo_x, hi_x = min(p[0] for p in seen), max(p[0] for p in seen)
+    lo_z, hi_z = min(p[2] for p in seen), max(p[2] for p in seen)
+    assert hi_x < -light_half or lo_x > light_half or hi_z < -light_half or lo_z > light_half, \
+        "the camera must not see the light through the hole"
+    assert abs(box_c[1] - box_half) < 1e-12 and max(abs(box_c[0]), abs(box_c[2])) - box_half < reach
+    scene.notes.append(f"from the floor under the hole, the hole's image on the light's plane is a {2 * img_half:g} m "
+                       f"square: {100.0 * visible:g}% of the light's area visible")
+    scene.notes.append(f"hole seen from the floor under it: projected solid angle {o_hole:.5f} sr; irradiance "
+                       f"{ke * o_hole:.4g} W/m^2, floor radiance {lo_hole:.4g} (k_d = {floor.kd[0]:g}); cosine "
+                       f"sampling hits the hole with probability {o_hole / math.pi:.4f}")
+    scene.notes.append(f"lit patch on the floor: the whole hole shows the light for |x|, |z| <= {plateau:.3g} m, "
+                       f"penumbra out to {reach:.3g} m, nothing beyond")
+    scene.notes.append(f"the eye sees through the hole onto the light's plane at x {lo_x:+.2f}..{hi_x:+.2f}, "
+                       f"z {lo_z:+.2f}..{hi_z:+.2f}: outside the light (|x|, |z| <= {light_half:g}), so it is never "
+                       f"seen directly")
+    return scene
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# 5. default
 
 def default():
     eye, target = (0.0, 1.25, 3.5), (0.0, 0.5, 0.0)
@@ -766,7 +872,7 @@ def check_scene(scene):
 
 
 def main():
-    scenes = [cornell_box(), veach_mis(), near_light(), default()]
+    scenes = [cornell_box(), veach_mis(), near_light(), occluded_light(), default()]
     if "--check-only" not in sys.argv[1:]:
         for s in scenes:
             write_scene(s)

@@ -14,7 +14,7 @@ pub fn load_and_render(data: &[u8]) -> bool {
     (scene.camera.width, scene.camera.height) = (2, 2);
     let scene = Arc::new(scene);
     for strategy in Strategy::ALL {
-        let renderer = Renderer::new(scene.clone(), RenderSettings { strategy, ..Default::default() });
+        let mut renderer = Renderer::new(scene.clone(), RenderSettings { strategy, ..Default::default() });
         let mut film = Film::new(2, 2);
         renderer.render_pass(&mut film, 0, 1, &|| false);
     }

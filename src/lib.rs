@@ -19,6 +19,7 @@
 
 pub mod app;
 pub mod fuzz;
+pub mod guiding;
 pub mod math;
 pub mod measure;
 pub mod probe;

@@ -24,7 +24,7 @@ struct Region {
 
 fn regions(scene: &Scene, strategy: Strategy, spp: u32, seed: u64) -> Vec<Region> {
     let settings = RenderSettings { strategy, light_selection: LightSelection::Power, seed, ..Default::default() };
-    let renderer = Renderer::new(std::sync::Arc::new(scene.clone()), settings);
+    let mut renderer = Renderer::new(std::sync::Arc::new(scene.clone()), settings);
     let (w, h) = (scene.camera.width, scene.camera.height);
     let mut film = Film::new(w, h);
     let stats = renderer.render_pass(&mut film, 0, spp, &|| false);

@@ -197,7 +197,7 @@ fn strategy_names() -> Vec<String> {
     stdout(&output).lines().filter_map(|l| l.split_whitespace().next()).map(str::to_string).collect()
 }
 
-const BUNDLED_SCENES: [&str; 4] = ["default", "cornell-box", "veach-mis", "near-light"];
+const BUNDLED_SCENES: [&str; 5] = ["default", "cornell-box", "veach-mis", "near-light", "occluded-light"];
 
 // ---------------------------------------------------------------------------------------------------------------
 // The control: the test scene itself is valid

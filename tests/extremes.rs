@@ -139,7 +139,7 @@ fn renders_of_extreme_scenes_drop_nothing() {
     for camera in cameras {
         let scene = std::sync::Arc::new(scene(camera));
         for settings in all_settings() {
-            let renderer = Renderer::new(scene.clone(), settings);
+            let mut renderer = Renderer::new(scene.clone(), settings);
             let mut film = Film::new(camera.width, camera.height);
             let stats = renderer.render_pass(&mut film, 0, 2, &|| false);
             assert_eq!(stats.non_finite, 0, "{settings:?}: non-finite samples");
@@ -152,7 +152,7 @@ fn renders_of_extreme_scenes_drop_nothing() {
 fn scene_without_triangles_renders_black() {
     let scene = Scene::new("empty", any_camera(), &[], &[], vec![], vec![]).expect("an empty scene is valid");
     assert!(scene.warnings.iter().any(|w| w.contains("no emitter")));
-    let renderer = Renderer::new(std::sync::Arc::new(scene), RenderSettings::default());
+    let mut renderer = Renderer::new(std::sync::Arc::new(scene), RenderSettings::default());
     let mut film = Film::new(8, 8);
     renderer.render_pass(&mut film, 0, 2, &|| false);
     assert!(film.means().iter().all(|c| *c == Vec3::ZERO));
@@ -168,7 +168,7 @@ fn the_probe_is_finite_at_the_extremes() {
     let scene = scene(any_camera());
     let emitters = EmitterSampler::new(&scene, LightSelection::Power);
     let mis = MisSettings::default();
-    let ctx = SampleContext { scene: &scene, emitters: emitters.as_ref(), mis: &mis, state: None };
+    let ctx = SampleContext { scene: &scene, emitters: emitters.as_ref(), mis: &mis, state: None, guide: None };
     let view = Vec3::new(0.2, 0.9, 0.1).normalize();
     let points = [
         (Vec3::new(0.1, 0.0, 0.0), Vec3::Y, Vec3::new(1.0, 1e-6, 0.3).normalize()),

@@ -56,7 +56,7 @@ fn load(obj: &str, mtl: Option<&str>) -> (TempDir, Result<Scene, String>) {
 fn film(scene: Scene) -> Vec<[f32; 3]> {
     let settings = RenderSettings { strategy: Strategy::Mis, ..Default::default() };
     let (w, h) = (scene.camera.width, scene.camera.height);
-    let renderer = Renderer::new(Arc::new(scene), settings);
+    let mut renderer = Renderer::new(Arc::new(scene), settings);
     let mut film = Film::new(w, h);
     renderer.render_pass(&mut film, 0, 4, &|| false);
     film.means().iter().map(|v| v.to_array()).collect()
@@ -190,7 +190,7 @@ fn normals_and_texture_coordinates_are_loaded_and_unused() {
 
 #[test]
 fn the_bundled_scenes_load_without_warnings_from_the_loader() {
-    for name in ["cornell-box", "veach-mis", "near-light", "default"] {
+    for name in ["cornell-box", "veach-mis", "near-light", "occluded-light", "default"] {
         let scene = illumlab::scene::load_scene(name).unwrap();
         assert!(
             scene.warnings.iter().all(|w| !w.contains("ignored") && !w.contains("MTL")),

@@ -89,6 +89,9 @@ fn strategy_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     if s == Strategy::Mis {
         mis_ui(v, ui);
     }
+    if Strategy::learns(&v.settings) || (v.comparing && Strategy::learns(&v.settings_b)) {
+        guide_ui(v, ui);
+    }
     let mut selection = v.settings.light_selection;
     egui::ComboBox::from_label("light selection p_Δ").selected_text(selection.name()).show_ui(ui, |ui| {
         for l in LightSelection::ALL {
@@ -127,6 +130,24 @@ fn mis_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     if mis != v.settings.mis {
         v.settings.mis = mis;
         v.apply_settings();
+    }
+}
+
+/// Path guiding: how long the guide learns, whether its training samples count, and starting it again.
+fn guide_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+    let mut guiding = v.settings.guiding;
+    ui.add(egui::Slider::new(&mut guiding.training_spp, 0..=1024).logarithmic(true).text("training spp"))
+        .on_hover_text(
+            "Iterations of 1, 2, 4, … samples per pixel learn the guide until this budget, then it is frozen",
+        );
+    ui.checkbox(&mut guiding.discard_training, "discard training samples")
+        .on_hover_text("Leave the training passes out of the image (each pass is unbiased either way)");
+    if guiding != v.settings.guiding {
+        v.settings.guiding = guiding;
+        v.apply_settings();
+    }
+    if ui.button("Reset guide").on_hover_text("Forget what the guide learned and learn again").clicked() {
+        v.reset_guide();
     }
 }
 

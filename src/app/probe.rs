@@ -8,6 +8,7 @@ use super::viewer::Viewer;
 use crate::math::luminance;
 use crate::probe::{HISTOGRAM_BINS, HISTOGRAM_DECADES, Layers, PROJECTION, ProbeSettings, chi2};
 use crate::session::probe::{ProbeRequest, ProbeView, ProbeWorker};
+use crate::session::worker::Frame;
 use egui_plot::{Bar, BarChart, Plot};
 
 /// What the probe panel shows and asks for.
@@ -87,14 +88,18 @@ impl Viewer {
         }
         let camera = self.probe.pixel.map_or(self.camera, |p| p.1);
         let mut lanes = vec![self.settings];
+        let guide_of = |f: Option<&Frame>| f.and_then(|f| f.guide.as_ref()).map(|(_, g)| g.clone());
+        let mut guides = vec![guide_of(self.frame.as_deref())];
         if self.comparing {
             lanes.push(self.settings_b);
+            guides.push(guide_of(self.frame_b.as_deref()));
         }
         let request = ProbeRequest {
             scene: self.scene.clone(),
             camera,
             pixel,
             lanes,
+            guides,
             settings: self.probe.settings,
             layers: self.probe.layers,
             table: self.probe.table,
@@ -150,6 +155,7 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         ui.checkbox(&mut l.ratio, "ratio");
         ui.checkbox(&mut l.outlines, "lights");
         ui.checkbox(&mut l.samples, "samples");
+        ui.checkbox(&mut l.guide, "learned guide").on_hover_text("guided: the density its guide learned here");
     });
     ui.horizontal(|ui| {
         // Copies, written back only when moved: a logarithmic slider may round the value it is given.

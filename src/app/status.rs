@@ -32,6 +32,22 @@ pub fn status_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         }
         ui.separator();
         ui.label(format!("{}×{}", f.width, f.height));
+        if let Some((t, _)) = &f.guide {
+            ui.separator();
+            let size = format!("{} leaves, {} nodes, {:.0} KiB", t.leaves, t.dtree_nodes, t.bytes as f64 / 1024.0);
+            ui.label(match (t.kept, t.frozen) {
+                (true, _) => format!("guide kept (frozen): {size}"),
+                (false, true) => {
+                    format!("guide frozen after {} iterations ({} spp): {size}", t.iteration, t.learned_spp)
+                }
+                (false, false) => format!(
+                    "guide learning: iteration {} ({} spp learned), {size}, built in {:.1} ms",
+                    t.iteration,
+                    t.learned_spp,
+                    t.build.as_secs_f64() * 1e3
+                ),
+            });
+        }
         if let Some(l) = v.restart_latency {
             ui.separator();
             ui.label(format!("restart to frame {:.0} ms", l.as_secs_f64() * 1e3));

@@ -281,6 +281,11 @@ impl Viewer {
         self.awaiting_frame.store(true, Ordering::Relaxed);
     }
 
+    /// Forgets what `guided` learned and learns again from the first sample.
+    pub(super) fn reset_guide(&mut self) {
+        self.send_restarting(Command::ResetGuide);
+    }
+
     pub(super) fn set_strategy(&mut self, strategy: Strategy) {
         if self.settings.strategy != strategy {
             self.settings.strategy = strategy;

@@ -1,7 +1,8 @@
 //! `illumlab bench`: every strategy at several budgets against a reference, written as CSV, markdown and a plot.
 
 use super::{
-    MisArgs, load_sized, parse_footprint, parse_light_selection, parse_size, parse_strategy, pass_size, thread_pool,
+    GuidingArgs, MisArgs, load_sized, parse_footprint, parse_light_selection, parse_size, parse_strategy, pass_size,
+    thread_pool,
 };
 use anyhow::{Context, Result, bail};
 use illumlab::measure::{
@@ -53,6 +54,12 @@ pub struct BenchArgs {
     pub light_selection: LightSelection,
     #[command(flatten)]
     pub mis: MisArgs,
+    #[command(flatten)]
+    pub guiding: GuidingArgs,
+    /// The strategy of a rendered reference: mis (projected-solid-angle + BRDF, power heuristic) or guided
+    /// (for scenes where light arrives through small openings, which MIS resolves slowly).
+    #[arg(long, value_parser = parse_strategy, default_value = "mis")]
+    pub reference_strategy: Strategy,
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub threads: Option<u32>,
@@ -78,12 +85,24 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         }
         None => {
             let spp = args.reference_spp.unwrap_or(16 * budgets.last().copied().unwrap_or(1));
-            let r = pool.install(|| render_reference(&scene, spp, args.footprint));
+            let settings = match args.reference_strategy {
+                Strategy::Mis => reference_settings(args.footprint),
+                Strategy::Guided => RenderSettings {
+                    strategy: Strategy::Guided,
+                    guiding: args.guiding.settings(),
+                    ..reference_settings(args.footprint)
+                },
+                other => bail!("--reference-strategy must be mis or guided, not {}", other.name()),
+            };
+            let r = pool.install(|| render_reference(&scene, spp, settings));
             let path = out.join("reference.exr");
             r.save_exr(&path)?;
+            let what = match settings.strategy {
+                Strategy::Guided => "guided (trained within its samples)",
+                _ => "MIS (projected-solid-angle + BRDF, power heuristic)",
+            };
             let line = format!(
-                "MIS (projected-solid-angle + BRDF, power heuristic), {spp} spp, {} footprint, rendered in {:.1} s, \
-                 saved as {}",
+                "{what}, {spp} spp, {} footprint, rendered in {:.1} s, saved as {}",
                 args.footprint.name(),
                 r.seconds,
                 path.display()
@@ -99,6 +118,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         seed: args.seed,
         mis: args.mis.settings(),
         footprint: args.footprint,
+        guiding: args.guiding.settings(),
     };
     let included: Option<Vec<bool>> =
         (!args.include_emitter_pixels).then(|| sees_emitter(&scene, args.footprint).into_iter().map(|s| !s).collect());
@@ -149,9 +169,9 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 
 const WALL: &str = "wall-clock seconds";
 
-/// Renders the reference with [`reference_settings`] in passes of a few samples.
-fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32, footprint: Footprint) -> Reference {
-    let renderer = Renderer::new(scene.clone(), reference_settings(footprint));
+/// Renders the reference with `settings` in passes of a few samples.
+fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32, settings: RenderSettings) -> Reference {
+    let mut renderer = Renderer::new(scene.clone(), settings);
     let mut film = Film::new(scene.camera.width, scene.camera.height);
     let chunk = pass_size(spp, film.pixels.len());
     let bar = indicatif::ProgressBar::new(spp as u64).with_style(

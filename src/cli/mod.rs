@@ -5,6 +5,7 @@ mod probe;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
+use illumlab::guiding::{GuideSettings, Training};
 use illumlab::render::{
     Film, Footprint, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
     write_image,
@@ -41,7 +42,7 @@ pub enum Command {
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
     /// A scene file (.toml, or a bare .obj) or the name of a bundled scene (default, cornell-box, veach-mis,
-    /// near-light).
+    /// near-light, occluded-light).
     pub scene: String,
     /// Sampling strategy (see `illumlab strategies`).
     #[arg(long, value_parser = parse_strategy)]
@@ -67,6 +68,8 @@ pub struct RenderArgs {
     pub exposure: f32,
     #[command(flatten)]
     pub mis: MisArgs,
+    #[command(flatten)]
+    pub guiding: GuidingArgs,
     /// Worker threads (default: all cores). The image does not depend on it.
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub threads: Option<u32>,
@@ -103,6 +106,8 @@ pub struct ViewArgs {
     pub size: Option<(u32, u32)>,
     #[command(flatten)]
     pub mis: MisArgs,
+    #[command(flatten)]
+    pub guiding: GuidingArgs,
     /// Open in compare mode with this strategy as B (A is --strategy).
     #[arg(long, value_parser = parse_strategy)]
     pub compare: Option<Strategy>,
@@ -138,6 +143,31 @@ pub struct MisArgs {
     /// MIS: directions per pixel sample from the first and the second technique, as L,B.
     #[arg(long, value_parser = parse_mis_samples, default_value = "1,1")]
     pub mis_samples: (u32, u32),
+}
+
+/// The options of `--strategy guided` (and of MIS with a guided technique).
+#[derive(clap::Args, Debug, Clone)]
+pub struct GuidingArgs {
+    /// guided: samples per pixel of training; the iterations (1, 2, 4, … spp) that end within it learn the
+    /// guide, later samples use it frozen.
+    #[arg(long, default_value_t = GuideSettings::default().training_spp)]
+    pub train_spp: u32,
+    /// guided: Müller's c; a spatial leaf with more than c·√(2^k) records in iteration k is split.
+    #[arg(long, default_value_t = GuideSettings::default().spatial_threshold, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spatial_threshold: u32,
+    /// guided: leave the training samples out of the image (by default every pass is kept: each is unbiased).
+    #[arg(long)]
+    pub discard_training: bool,
+}
+
+impl GuidingArgs {
+    pub(crate) fn settings(&self) -> GuideSettings {
+        GuideSettings {
+            training_spp: self.train_spp,
+            spatial_threshold: self.spatial_threshold,
+            discard_training: self.discard_training,
+        }
+    }
 }
 
 impl MisArgs {
@@ -237,6 +267,7 @@ pub fn run(command: Command) -> Result<()> {
                 seed: args.seed,
                 mis: args.mis.settings(),
                 footprint: args.footprint,
+                guiding: args.guiding.settings(),
             },
             target_spp: args.target_spp,
             exposure: args.exposure,
@@ -265,9 +296,10 @@ fn render(args: RenderArgs) -> Result<()> {
         seed: args.seed,
         mis: args.mis.settings(),
         footprint: args.footprint,
+        guiding: args.guiding.settings(),
     };
     let mut film = Film::new(scene.camera.width, scene.camera.height);
-    let renderer = Renderer::new(std::sync::Arc::new(scene), settings);
+    let mut renderer = Renderer::new(std::sync::Arc::new(scene), settings);
 
     // Passes of a few samples each: the progress bar advances between them; the result does not depend on it.
     let chunk = pass_size(args.spp, film.pixels.len());
@@ -295,6 +327,9 @@ fn render(args: RenderArgs) -> Result<()> {
         b.finish_and_clear();
     }
     write_image(&film, &args.output, args.exposure)?;
+    if let Some(training) = renderer.training() {
+        print_training(training);
+    }
     println!(
         "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped -> {}",
         args.spp,
@@ -305,6 +340,26 @@ fn render(args: RenderArgs) -> Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// What each iteration of a guide's training built (to standard error: the last line on standard output stays
+/// the render's summary).
+pub(crate) fn print_training(training: &Training) {
+    for r in training.log() {
+        eprintln!(
+            "guide iteration {}: learned from {} spp ({} records), {} spatial leaves, {} quadtree nodes, {:.1} KiB, \
+             built in {:.1} ms",
+            r.iteration,
+            r.spp,
+            r.records,
+            r.leaves,
+            r.dtree_nodes,
+            r.bytes as f64 / 1024.0,
+            r.build.as_secs_f64() * 1e3
+        );
+    }
+    let frozen = if training.is_frozen() { "frozen" } else { "still learning" };
+    eprintln!("guide: {frozen} after {} iterations", training.log().len());
 }
 
 /// Loads a scene (file or bundled), overrides the camera's size if asked, and prints its warnings.

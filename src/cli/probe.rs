@@ -1,11 +1,11 @@
 //! `illumlab probe`: the probe at one pixel, headless: the estimate, its interval, the quadrature value, the
 //! z-score, the relative variance, the chi-square p-value and the zero samples by cause, and the picture.
 
-use super::{MisArgs, load_sized, parse_light_selection, parse_strategy};
+use super::{GuidingArgs, MisArgs, load_sized, parse_light_selection, parse_strategy, print_training};
 use anyhow::{Context, Result, bail};
 use illumlab::math::luminance;
 use illumlab::probe::{Layers, Probe, ProbeJson, ProbeSettings, chi2};
-use illumlab::render::{Footprint, RenderSettings, Strategy, check_output_path, write_png_rgba};
+use illumlab::render::{Film, Footprint, RenderSettings, Renderer, Strategy, check_output_path, write_png_rgba};
 use illumlab::scene::LightSelection;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -29,6 +29,9 @@ pub struct ProbeArgs {
     pub light_selection: LightSelection,
     #[command(flatten)]
     pub mis: MisArgs,
+    /// guided: its guide is first learned by rendering the scene for --train-spp samples per pixel.
+    #[command(flatten)]
+    pub guiding: GuidingArgs,
     /// Image size WxH, overriding the scene's camera (the pixel is in this size).
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
@@ -69,8 +72,19 @@ pub fn probe(args: ProbeArgs) -> Result<()> {
         seed: args.seed,
         mis: args.mis.settings(),
         footprint: Footprint::Jittered,
+        guiding: args.guiding.settings(),
     };
-    let probe = Probe::new(scene.clone(), settings);
+    // A strategy that learns is probed with the guide it learns over the whole image.
+    let guide = Strategy::learns(&settings).then(|| {
+        let mut renderer = Renderer::new(scene.clone(), settings);
+        let mut film = Film::new(w, h);
+        renderer.render_pass(&mut film, 0, settings.guiding.training_end(), &|| false);
+        if let Some(t) = renderer.training() {
+            print_training(t);
+        }
+        renderer.guide().cloned()
+    });
+    let probe = Probe::new(scene.clone(), settings).with_guide(guide.flatten());
     let point = probe
         .point(args.pixel)
         .with_context(|| format!("the camera ray through pixel {},{} meets no surface", args.pixel.0, args.pixel.1))?;

@@ -9,7 +9,8 @@
 //! on rayon's pool; images (and so errors) are a pure function of the seeds, only the timings vary between runs.
 
 use super::{ConvergencePoint, ErrorMetrics, MeanInterval, Reference, Series, error_over};
-use crate::render::{Film, RenderSettings, Renderer, Strategy};
+use crate::guiding::IterationReport;
+use crate::render::{Census, Film, RenderSettings, Renderer, Strategy};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::sync::Arc;
@@ -69,6 +70,10 @@ pub struct BenchReport {
     /// Pixels measured, and pixels left out.
     pub pixels: usize,
     pub excluded: usize,
+    /// Per strategy (first seed, after its largest budget): how many of its traced directions found light.
+    pub census: Vec<(String, Census)>,
+    /// Per strategy that learns a guide (first seed): what each training iteration built.
+    pub guides: Vec<(String, Vec<IterationReport>)>,
 }
 
 /// `1/(x · seconds)` where finite and positive.
@@ -89,13 +94,14 @@ pub fn run_bench(
     let (w, h) = (scene.camera.width, scene.camera.height);
     let pixels = included.map_or((w * h) as usize, |inc| inc.iter().filter(|&&b| b).count());
     let (mut rows, mut series, mut intervals) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut census, mut guides) = (Vec::new(), Vec::new());
     let noise = error_over(&reference.mean, reference, included);
     for &strategy in &plan.strategies {
         // Per seed and budget: seconds so far, the metrics, non-finite samples so far.
         let mut runs: Vec<Vec<(f64, ErrorMetrics, u64)>> = Vec::new();
         for k in 0..plan.seeds.max(1) {
             let settings = RenderSettings { strategy, seed: plan.base.seed.wrapping_add(k as u64), ..plan.base };
-            let renderer = Renderer::new(scene.clone(), settings);
+            let mut renderer = Renderer::new(scene.clone(), settings);
             let mut film = Film::new(w, h);
             let (mut done, mut seconds, mut dropped) = (0u32, 0.0f64, 0u64);
             let mut run = Vec::new();
@@ -110,6 +116,14 @@ pub fn run_bench(
                 progress(strategy, k, done);
             }
             runs.push(run);
+            if k == 0 {
+                // About 16 000 pixels, 4 samples each, after the last budget (a guide as trained by then).
+                let stride = ((w * h) as usize / 16_000).max(1);
+                census.push((strategy.name().to_string(), renderer.census(done, 4, stride)));
+                if let Some(t) = renderer.training() {
+                    guides.push((strategy.name().to_string(), t.log().to_vec()));
+                }
+            }
         }
         let mut line = Series::new(strategy.name());
         let mut per_budget = Vec::new();
@@ -149,7 +163,8 @@ pub fn run_bench(
         intervals.push(per_budget);
     }
     let excluded = (w * h) as usize - pixels;
-    BenchReport { rows, intervals, series, reference_rmse: noise.reference_mse.sqrt(), pixels, excluded }
+    let reference_rmse = noise.reference_mse.sqrt();
+    BenchReport { rows, intervals, series, reference_rmse, pixels, excluded, census, guides }
 }
 
 #[cfg(test)]

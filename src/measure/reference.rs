@@ -31,6 +31,7 @@ pub fn reference_settings(footprint: Footprint) -> RenderSettings {
             heuristic: Heuristic::Power,
             samples: [1, 1],
         },
+        ..Default::default()
     }
 }
 

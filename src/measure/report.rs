@@ -131,6 +131,31 @@ pub fn markdown(report: &BenchReport, ctx: &BenchContext) -> String {
             let _ = writeln!(md, "{v}");
         }
     }
+    if !report.census.is_empty() {
+        let rates: Vec<String> =
+            report.census.iter().map(|(s, c)| format!("{s} {:.1}%", 100.0 * c.success_rate())).collect();
+        let _ = writeln!(md, "\nTraced directions (shadow and BRDF rays) that found light: {}.", rates.join(", "));
+    }
+    for (strategy, log) in &report.guides {
+        let _ = writeln!(
+            md,
+            "\n{strategy}'s guide, per training iteration: spp learned from, records, spatial leaves, quadtree \
+             nodes, KiB, build ms:"
+        );
+        for r in log {
+            let _ = writeln!(
+                md,
+                "- {}: {} spp, {} records, {} leaves, {} nodes, {:.1} KiB, {:.1} ms",
+                r.iteration,
+                r.spp,
+                r.records,
+                r.leaves,
+                r.dtree_nodes,
+                r.bytes as f64 / 1024.0,
+                r.build.as_secs_f64() * 1e3
+            );
+        }
+    }
     md
 }
 
@@ -187,7 +212,8 @@ mod tests {
             series.push(s);
             intervals.push(vec![[m, m]]);
         }
-        BenchReport { rows, intervals, series, reference_rmse: 1e-3, pixels: 90, excluded: 10 }
+        let (census, guides) = (Vec::new(), Vec::new());
+        BenchReport { rows, intervals, series, reference_rmse: 1e-3, pixels: 90, excluded: 10, census, guides }
     }
 
     fn ctx() -> BenchContext<'static> {

@@ -1,8 +1,9 @@
 //! A strategy's density at any direction, over the whole sphere. For the hemisphere strategies it is their
 //! `pdf(ω)`; a light strategy can reach ω through every facing emitter triangle ω passes through (occluded or
 //! not: the shadow ray is traced after sampling), so its density is the sum of `p_Δ p(ω | Δ)` over them; MIS's
-//! is the mixture of its two techniques' densities.
+//! is the mixture of its two techniques' densities, and `guided`'s that of its guide, emitter and BRDF parts.
 
+use crate::render::strategy::guided;
 use crate::render::strategy::light::faces;
 use crate::render::{Domain, Reached, SampleContext, ShadingPoint, Strategy};
 use glam::Vec3;
@@ -33,6 +34,15 @@ pub fn density(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, wi: V
             }
             let [n0, n1] = ctx.mis.samples.map(|n| n as f32);
             (n0 * density(ctx, sp, t0, wi) + n1 * density(ctx, sp, t1, wi)) / (n0 + n1)
+        }
+        Domain::Learned => {
+            let [c_g, c_l, c_b] = guided::weights(ctx, sp);
+            let guide = match ctx.guide {
+                Some(g) if c_g > 0.0 => g.dtree(sp.p).pdf(wi),
+                _ => 0.0,
+            };
+            let light = if c_l > 0.0 { density(ctx, sp, Strategy::Emitter, wi) } else { 0.0 };
+            c_g * guide + c_l * light + c_b * density(ctx, sp, Strategy::Brdf, wi)
         }
     }
 }

@@ -18,6 +18,7 @@ pub use picture::{Layers, Maps, PROJECTION, Picture};
 pub use point::ProbePoint;
 pub use quadrature::{Quadrature, RELATIVE_TOLERANCE, quadrature};
 
+use crate::guiding::Guide;
 use crate::math::luminance;
 use crate::render::strategy::StrategyState;
 use crate::render::{RenderSettings, SampleContext, Strategy};
@@ -54,6 +55,8 @@ pub struct Probe {
     settings: RenderSettings,
     emitters: Option<EmitterSampler>,
     state: Option<StrategyState>,
+    /// The guide `guided` samples from (a lane's, as learned so far).
+    guide: Option<Arc<Guide>>,
 }
 
 /// Everything a probe found at one point for one strategy.
@@ -82,7 +85,13 @@ impl Probe {
     pub fn new(scene: Arc<Scene>, settings: RenderSettings) -> Self {
         let emitters = EmitterSampler::new(&scene, settings.light_selection);
         let state = settings.strategy.prepare(&scene, &settings);
-        Self { scene, settings, emitters, state }
+        Self { scene, settings, emitters, state, guide: None }
+    }
+
+    /// Probes with a learned guide (what `guided` samples from at the probed point).
+    pub fn with_guide(mut self, guide: Option<Arc<Guide>>) -> Self {
+        self.guide = guide;
+        self
     }
 
     pub fn scene(&self) -> &Arc<Scene> {
@@ -91,7 +100,8 @@ impl Probe {
 
     pub fn context(&self) -> SampleContext<'_> {
         let state = self.state.as_deref();
-        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis, state }
+        let guide = self.guide.as_deref();
+        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis, state, guide }
     }
 
     /// The point under pixel (x, y) of the scene's camera.

@@ -27,11 +27,13 @@ pub struct Layers {
     pub ratio: bool,
     pub outlines: bool,
     pub samples: bool,
+    /// The learned guide's density at the point (where a guide is given).
+    pub guide: bool,
 }
 
 impl Default for Layers {
     fn default() -> Self {
-        Self { integrand: true, density: true, ratio: true, outlines: true, samples: true }
+        Self { integrand: true, density: true, ratio: true, outlines: true, samples: true, guide: true }
     }
 }
 
@@ -49,6 +51,8 @@ pub struct Maps {
     /// `luminance(f_r L_i (ω·n)) / L_o` (a density: ∫ = 1 over the hemisphere).
     pub integrand: Vec<f32>,
     pub density: Vec<f32>,
+    /// The learned guide's density p_guide(ω) at the point's spatial leaf, where the context has a guide.
+    pub guide: Option<Vec<f32>>,
     /// The strategy's probability of sampling below the horizon (where the disk shows nothing).
     pub below_horizon: f32,
 }
@@ -75,10 +79,17 @@ impl Maps {
         // ∫ p over the upper hemisphere from the grid (dω = 2 dA, a pixel's area (2/size)²); the rest is below.
         let cell = SOLID_ANGLE_PER_DISK_AREA * (2.0 / size as f32).powi(2);
         let above: f32 = values.iter().filter(|v| v.1.is_finite()).map(|v| v.1 * cell).sum();
+        let guide = ctx.guide.map(|g| {
+            let dtree = g.dtree(sp.p);
+            (0..size * size)
+                .map(|i| disk_point(i, size).map_or(f32::NAN, |d| dtree.pdf(frame.to_world(disk_to_hemisphere(d)))))
+                .collect()
+        });
         Self {
             size,
             integrand: values.iter().map(|v| v.0).collect(),
             density: values.iter().map(|v| v.1).collect(),
+            guide,
             below_horizon: (1.0 - above).clamp(0.0, 1.0),
         }
     }
@@ -212,7 +223,8 @@ fn weight_colour(relative: f32) -> [u8; 4] {
     [c.r, c.g, c.b, 235]
 }
 
-/// Draws the picture: one disk of `maps.size` pixels per switched-on heatmap, side by side.
+/// Draws the picture: one disk of `maps.size` pixels per switched-on heatmap, side by side (integrand, density,
+/// their ratio, and the learned guide's density where there is one), on one log scale.
 pub fn draw(
     ctx: &SampleContext,
     sp: &ShadingPoint,
@@ -222,7 +234,8 @@ pub fn draw(
     layers: Layers,
 ) -> Picture {
     let s = maps.size;
-    let panels: Vec<u8> = [(layers.integrand, 0u8), (layers.density, 1), (layers.ratio, 2)]
+    let guide = maps.guide.as_deref().filter(|_| layers.guide);
+    let panels: Vec<u8> = [(layers.integrand, 0u8), (layers.density, 1), (layers.ratio, 2), (guide.is_some(), 3)]
         .into_iter()
         .filter_map(|(on, k)| on.then_some(k))
         .collect();
@@ -249,7 +262,8 @@ pub fn draw(
                 match kind {
                     0 => density_colour(g, top),
                     1 => density_colour(p, top),
-                    _ => ratio_colour(g, p),
+                    2 => ratio_colour(g, p),
+                    _ => density_colour(guide.map_or(0.0, |m| m[i]), top),
                 }
             };
             pic.blend((x0 + i % s) as i32, (i / s) as i32, c);

@@ -23,7 +23,7 @@ pub fn estimate_direct(
     rays: &mut u64,
 ) -> Vec3 {
     let state = settings.strategy.prepare(scene, settings);
-    let ctx = SampleContext { scene, emitters, mis: &settings.mis, state: state.as_deref() };
+    let ctx = SampleContext { scene, emitters, mis: &settings.mis, state: state.as_deref(), guide: None };
     settings.strategy.estimate(&ctx, sp, rng, rays, &mut ())
 }
 
@@ -40,11 +40,12 @@ pub fn one_sample<S: SampleSink>(
         sink.record(SampleRecord::none(0));
         return Vec3::ZERO;
     };
-    let (contribution, outcome) = match integrand(scene, sp, &s, rays) {
-        Ok((value, _)) => (value / s.pdf, Outcome::Contributed),
-        Err(outcome) => (Vec3::ZERO, outcome),
+    let (contribution, radiance, outcome) = match integrand(scene, sp, &s, rays) {
+        Ok((value, via)) => (value / s.pdf, scene.emitted(via.triangle, -s.wi), Outcome::Contributed),
+        Err(outcome) => (Vec3::ZERO, Vec3::ZERO, outcome),
     };
-    sink.record(SampleRecord { technique: 0, wi: s.wi, pdf: s.pdf, mis_weight: 1.0, contribution, outcome });
+    let (wi, pdf) = (s.wi, s.pdf);
+    sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome });
     contribution
 }
 

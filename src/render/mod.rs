@@ -17,7 +17,7 @@ pub use film::{Film, PixelAccum};
 pub use footprint::Footprint;
 pub use lanes::LANES;
 pub use output::{OutputError, OutputFormat, check_output_path, srgb_bytes, write_image, write_png_rgba};
-pub use pass::{PassStats, RenderSettings, Renderer};
+pub use pass::{Census, PassStats, RenderSettings, Renderer};
 pub use shading::ShadingPoint;
 pub use sink::{Outcome, SampleRecord, SampleSink};
 pub use strategy::{DirectionSample, Domain, Heuristic, MisSettings, Reached, SampleContext, Strategy, Target};

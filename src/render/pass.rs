@@ -3,9 +3,11 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
+use super::sink::{SampleRecord, SampleSink};
 use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
-use crate::math::{PixelStreams, SampleRng};
+use crate::guiding::{Guide, GuideRecord, GuideSettings, Training, dir_to_square};
+use crate::math::{PixelStreams, SampleRng, luminance};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
@@ -31,6 +33,8 @@ pub struct RenderSettings {
     pub mis: MisSettings,
     /// Where camera rays go in their pixels.
     pub footprint: Footprint,
+    /// How `guided` learns its guide.
+    pub guiding: GuideSettings,
 }
 
 impl Default for RenderSettings {
@@ -41,6 +45,7 @@ impl Default for RenderSettings {
             seed: 0,
             mis: MisSettings::default(),
             footprint: Footprint::Jittered,
+            guiding: GuideSettings::default(),
         }
     }
 }
@@ -68,7 +73,9 @@ impl std::ops::AddAssign for PassStats {
 }
 
 /// Renders a scene with fixed settings, pass after pass. It owns what is built once per scene and settings and
-/// kept across passes: the light selection's p_Δ tables and the pixel cones.
+/// kept across passes: the light selection's p_Δ tables, the pixel cones and, for `guided`, the guide it learns
+/// (see [`crate::guiding::Training`]; a render is still a function of scene, settings and seed, whatever the
+/// split into passes and the number of threads).
 pub struct Renderer {
     scene: Arc<Scene>,
     settings: RenderSettings,
@@ -78,6 +85,8 @@ pub struct Renderer {
     cones: Arc<PixelCones>,
     /// The strategy's own state ([`super::strategy::DirectionStrategy::prepare`]).
     state: Option<StrategyState>,
+    /// The guide being learned, when the strategy learns one.
+    training: Option<Training>,
 }
 
 impl Renderer {
@@ -91,6 +100,7 @@ impl Renderer {
         Self {
             emitters: EmitterSampler::new(&scene, settings.light_selection),
             state: settings.strategy.prepare(&scene, &settings),
+            training: Strategy::learns(&settings).then(|| Training::new(&scene, settings.guiding)),
             scene,
             settings,
             camera: camera.basis(),
@@ -114,7 +124,29 @@ impl Renderer {
             emitters: self.emitters.as_ref(),
             mis: &self.settings.mis,
             state: self.state.as_deref(),
+            guide: self.guide().map(|g| &**g),
         }
+    }
+
+    /// The guide passes sample from now, when the strategy learns one.
+    pub fn guide(&self) -> Option<&Arc<Guide>> {
+        self.training.as_ref().map(Training::guide)
+    }
+
+    /// The guide's training (its log and status), when the strategy learns one.
+    pub fn training(&self) -> Option<&Training> {
+        self.training.as_ref()
+    }
+
+    /// Samples from a guide learned earlier for the same light, frozen (a viewer keeps it across camera and
+    /// material changes); ignored if the strategy learns none or the guide is of another scene's light.
+    pub fn with_guide(mut self, guide: Arc<Guide>) -> Self {
+        if let Some(t) = &mut self.training
+            && guide.fingerprint == t.guide().fingerprint
+        {
+            *t = Training::kept(guide, self.settings.guiding);
+        }
+        self
     }
 
     /// The pixel cones this renderer found and keeps, to give to a later renderer of the same scene geometry
@@ -135,14 +167,53 @@ impl Renderer {
 
     /// Adds samples `first..first + count` to every pixel of `film` (which must match the camera's size).
     /// `cancelled` is polled once per row; when it returns true the pass stops early and leaves the film
-    /// partially updated (the caller discards it).
+    /// partially updated (the caller discards it). A strategy that learns takes the pass in parts that never
+    /// cross a training iteration's end, records the directions evaluated in the parts that learn, and builds
+    /// its next guide between them.
     pub fn render_pass(
-        &self,
+        &mut self,
         film: &mut Film,
         first: u32,
         count: u32,
         cancelled: &(dyn Fn() -> bool + Sync),
     ) -> PassStats {
+        let end = first + count;
+        let mut stats = PassStats::default();
+        let mut s = first;
+        while s < end {
+            let (mut stop, learn) = match &mut self.training {
+                Some(t) => t.plan(s, end),
+                None => (end, false),
+            };
+            let training_end = self.settings.guiding.training_end();
+            let keep = !(self.training.is_some() && self.settings.guiding.discard_training && s < training_end);
+            if !keep {
+                stop = stop.min(training_end);
+            }
+            let (part, records) = self.render_range(film, s, stop - s, learn, keep, cancelled);
+            stats += part;
+            if cancelled() {
+                break;
+            }
+            if let (Some(t), true) = (&mut self.training, learn) {
+                t.learn(records.into_iter().flatten(), stop);
+            }
+            s = stop;
+        }
+        stats
+    }
+
+    /// Samples `first..first + count` of every pixel, added to `film` if `keep`; with `learn`, the guide records
+    /// of each row, in row order.
+    fn render_range(
+        &self,
+        film: &mut Film,
+        first: u32,
+        count: u32,
+        learn: bool,
+        keep: bool,
+        cancelled: &(dyn Fn() -> bool + Sync),
+    ) -> (PassStats, Vec<Vec<GuideRecord>>) {
         let width = film.width;
         assert_eq!((film.width, film.height), self.size, "film and camera sizes differ");
         film.pixels
@@ -150,15 +221,17 @@ impl Renderer {
             .enumerate()
             .map(|(y, row)| {
                 let mut stats = PassStats::default();
+                let mut records = Vec::new();
                 if cancelled() {
-                    return stats;
+                    return (stats, records);
                 }
                 let cpu = ThreadTime::now();
+                let mut learned = learn.then_some(&mut records);
                 let mut add = |acc: &mut PixelAccum, v: Vec3| {
-                    if v.is_finite() {
-                        acc.add(v);
-                    } else {
+                    if !v.is_finite() {
                         stats.non_finite += 1;
+                    } else if keep {
+                        acc.add(v);
                     }
                 };
                 let mut rays = 0;
@@ -170,7 +243,8 @@ impl Renderer {
                             let mut rng = streams.sample(s as u64);
                             let (dir, hit) = self.camera_ray(x as u32, y as u32, &mut rng);
                             rays += 1;
-                            add(acc, hit.map_or(Vec3::ZERO, |hit| self.shade(dir, &hit, &mut rng, &mut rays)));
+                            let learned = learned.as_deref_mut();
+                            add(acc, hit.map_or(Vec3::ZERO, |hit| self.shade(dir, &hit, &mut rng, &mut rays, learned)));
                         }
                     }
                 } else {
@@ -184,7 +258,8 @@ impl Renderer {
                             let samples = group..(group + LANES as u32).min(first + count);
                             let n = samples.len();
                             let pixel = (x as u32, y as u32);
-                            let values = self.sample_lanes(pixel, &streams, samples, cone.as_ref(), &mut rays);
+                            let learned = learned.as_deref_mut();
+                            let values = self.sample_lanes(pixel, &streams, samples, cone.as_ref(), &mut rays, learned);
                             values[..n].iter().for_each(|&v| add(acc, v));
                         }
                     }
@@ -192,12 +267,50 @@ impl Renderer {
                 stats.rays = rays;
                 stats.samples = count as u64 * width as u64;
                 stats.cpu = cpu.elapsed();
-                stats
+                (stats, records)
             })
-            .reduce(PassStats::default, |mut a, b| {
-                a += b;
-                a
+            .collect::<Vec<_>>()
+            .into_iter()
+            .fold((PassStats::default(), Vec::new()), |(mut stats, mut rows), (s, records)| {
+                stats += s;
+                if learn {
+                    rows.push(records);
+                }
+                (stats, rows)
             })
+    }
+
+    /// Counts, over every `stride`-th pixel's samples `first..first + count` (taken as a pass would take them,
+    /// but not added to any film), the directions along which L_i was looked for and those that found light:
+    /// how often a strategy's shadow and BRDF rays pay off. Outside the timed passes: it costs what it counts.
+    pub fn census(&self, first: u32, count: u32, stride: usize) -> Census {
+        let (width, height) = self.size;
+        (0..(width as usize * height as usize))
+            .into_par_iter()
+            .step_by(stride.max(1))
+            .map(|i| {
+                let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+                let streams = PixelStreams::new(self.settings.seed, i as u64);
+                let mut census = Census::default();
+                for s in first..first + count {
+                    let mut rng = streams.sample(s as u64);
+                    let (dir, hit) = self.camera_ray(x, y, &mut rng);
+                    if let Some(hit) = hit {
+                        let sp = self.shading_point(dir, &hit);
+                        self.settings.strategy.estimate(&self.context(), &sp, &mut rng, &mut 0, &mut census);
+                    }
+                }
+                census
+            })
+            .reduce(Census::default, |a, b| Census { traced: a.traced + b.traced, lit: a.lit + b.lit })
+    }
+
+    /// The shading point at a camera ray's hit.
+    #[inline]
+    fn shading_point(&self, dir: Vec3, hit: &Hit) -> ShadingPoint<'_> {
+        let tri = &self.scene.triangles[hit.triangle as usize];
+        let material = &self.scene.materials[tri.material as usize];
+        ShadingPoint::on_triangle(self.scene.hit_point(hit), tri, -dir, material)
     }
 
     /// A camera ray through pixel (x, y), at a uniformly jittered position (box filter) or its centre (see
@@ -219,6 +332,7 @@ impl Renderer {
         samples: Range<u32>,
         cone: Option<&ConeCandidates>,
         rays: &mut u64,
+        mut learned: Option<&mut Vec<GuideRecord>>,
     ) -> [Vec3; LANES] {
         let n = samples.len();
         let mut rngs = streams.samples(samples.start as u64);
@@ -262,21 +376,76 @@ impl Renderer {
                 }
             }
             _ => std::array::from_fn(|l| {
-                hits.lane(l).map_or(Vec3::ZERO, |hit| self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays))
+                hits.lane(l).map_or(Vec3::ZERO, |hit| {
+                    self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays, learned.as_deref_mut())
+                })
             }),
         }
     }
 
-    /// One sample of `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface x seen along the camera ray `dir`.
+    /// One sample of `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface x seen along the camera ray `dir`;
+    /// with `learned`, the directions evaluated are recorded there for the guide.
     #[inline]
-    fn shade(&self, dir: Vec3, hit: &Hit, rng: &mut SampleRng, rays: &mut u64) -> Vec3 {
-        let tri = &self.scene.triangles[hit.triangle as usize];
-        let p = self.scene.hit_point(hit);
-        let wo = -dir;
-        let material = &self.scene.materials[tri.material as usize];
-        let sp = ShadingPoint::on_triangle(p, tri, wo, material);
-        let emitted = self.scene.emitted(hit.triangle, wo);
-        emitted + self.settings.strategy.estimate(&self.context(), &sp, rng, rays, &mut ())
+    fn shade(
+        &self,
+        dir: Vec3,
+        hit: &Hit,
+        rng: &mut SampleRng,
+        rays: &mut u64,
+        learned: Option<&mut Vec<GuideRecord>>,
+    ) -> Vec3 {
+        let sp = self.shading_point(dir, hit);
+        let emitted = self.scene.emitted(hit.triangle, -dir);
+        let (strategy, ctx) = (self.settings.strategy, self.context());
+        let estimate = match (learned, ctx.guide) {
+            (Some(out), Some(guide)) => {
+                let mut learner = Learner { leaf: guide.stree.leaf(sp.p), out };
+                strategy.estimate(&ctx, &sp, rng, rays, &mut learner)
+            }
+            _ => strategy.estimate(&ctx, &sp, rng, rays, &mut ()),
+        };
+        emitted + estimate
+    }
+}
+
+/// Directions along which L_i was looked for (a ray traced), and those that found light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Census {
+    pub traced: u64,
+    pub lit: u64,
+}
+
+impl Census {
+    /// The share of traced directions that found light.
+    pub fn success_rate(&self) -> f64 {
+        if self.traced == 0 { 0.0 } else { self.lit as f64 / self.traced as f64 }
+    }
+}
+
+impl SampleSink for Census {
+    fn record(&mut self, r: SampleRecord) {
+        if r.traced() {
+            self.traced += 1;
+            self.lit += (r.radiance != Vec3::ZERO) as u64;
+        }
+    }
+}
+
+/// The sink of a pass that learns: every direction along which L_i was found becomes a guide record of the
+/// shading point's spatial leaf, valued `w L_i / p` (luminance; w the MIS weight, 1 outside MIS): an unbiased
+/// estimate of ∫ L_i over the direction's cell, whichever technique drew it.
+struct Learner<'a> {
+    leaf: u32,
+    out: &'a mut Vec<GuideRecord>,
+}
+
+impl SampleSink for Learner<'_> {
+    #[inline]
+    fn record(&mut self, r: SampleRecord) {
+        if r.traced() && r.pdf > 0.0 {
+            let value = r.mis_weight * luminance(r.radiance) / r.pdf;
+            self.out.push(GuideRecord { leaf: self.leaf, square: dir_to_square(r.wi), value });
+        }
     }
 }
 
@@ -291,10 +460,11 @@ mod tests {
     fn kept_cones_are_taken_for_the_same_camera_only() {
         let (_, scene, camera) = every_bundled_scene(24, 16).find(|(name, ..)| *name == "veach-mis").expect("bundled");
         let scene = Arc::new(scene);
-        let first = Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera);
+        let mut first = Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera);
         let mut kept = Film::new(camera.width, camera.height);
         first.render_pass(&mut kept, 0, 8, &|| false);
-        let second = Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera).with_cones(first.cones());
+        let mut second =
+            Renderer::with_camera(scene.clone(), RenderSettings::default(), &camera).with_cones(first.cones());
         assert!(Arc::ptr_eq(&second.cones(), &first.cones()), "same camera: the cones are taken");
         second.render_pass(&mut kept, 8, 8, &|| false);
         let mut fresh = Film::new(camera.width, camera.height);
@@ -338,8 +508,12 @@ mod tests {
             let scene = Arc::new(scene);
             for settings in &settings {
                 let settings = RenderSettings { seed: 3, ..*settings };
-                let renderer = Renderer::with_camera(scene.clone(), settings, &camera);
+                // A renderer per film (a learning strategy's guide is the renderer's), sharing the first one's
+                // cones once found.
+                let first = Renderer::with_camera(scene.clone(), settings, &camera);
                 let film = |passes: &[u32]| {
+                    let mut renderer =
+                        Renderer::with_camera(scene.clone(), settings, &camera).with_cones(first.cones());
                     let mut film = Film::new(camera.width, camera.height);
                     let mut first = 0;
                     for &count in passes {

@@ -63,6 +63,9 @@ pub struct SampleRecord {
     pub mis_weight: f32,
     /// What it adds to the estimate: `w f_r L_i (ω·n) / (n p)`.
     pub contribution: Vec3,
+    /// L_i(ω_k): the radiance that arrived along it (zero where it was occluded or missed every light; zero
+    /// too where no ray was traced, see `outcome`).
+    pub radiance: Vec3,
     pub outcome: Outcome,
 }
 
@@ -70,8 +73,14 @@ impl SampleRecord {
     /// A strategy that could draw no direction.
     #[inline(always)]
     pub fn none(technique: u8) -> Self {
-        let (wi, contribution) = (Vec3::ZERO, Vec3::ZERO);
-        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, outcome: Outcome::NoSample }
+        let (wi, contribution, radiance) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, radiance, outcome: Outcome::NoSample }
+    }
+
+    /// Whether L_i was found along ω_k (a ray was traced): what a learning strategy can learn from.
+    #[inline(always)]
+    pub fn traced(&self) -> bool {
+        matches!(self.outcome, Outcome::Contributed | Outcome::MissedLights | Outcome::Occluded)
     }
 }
 

@@ -30,8 +30,13 @@ macro_rules! bundled {
 }
 
 /// Every bundled scene; the first is the viewer's default.
-pub const BUNDLED_SCENES: &[BundledScene] =
-    &[bundled!("default"), bundled!("cornell-box"), bundled!("veach-mis"), bundled!("near-light")];
+pub const BUNDLED_SCENES: &[BundledScene] = &[
+    bundled!("default"),
+    bundled!("cornell-box"),
+    bundled!("veach-mis"),
+    bundled!("near-light"),
+    bundled!("occluded-light"),
+];
 
 /// The scene the viewer opens on.
 pub const DEFAULT_SCENE: &str = "default";

@@ -3,6 +3,7 @@
 //! or a chi-square test. Requests supersede each other (only the newest pending one is computed), the quadrature
 //! of a point is kept while only the strategies change, and the answer comes through a latest-value slot.
 
+use crate::guiding::Guide;
 use crate::probe::{
     Layers, Picture, Probe, ProbeJson, ProbePoint, ProbeReport, ProbeSettings, Quadrature, StrategyRow, quadrature,
 };
@@ -22,6 +23,9 @@ pub struct ProbeRequest {
     pub pixel: (u32, u32),
     /// Lane A's settings, and B's in compare mode (the same samples' streams: common random numbers).
     pub lanes: Vec<RenderSettings>,
+    /// Per lane: the guide its renderer samples from now (a strategy that learns one), as of the lane's newest
+    /// frame.
+    pub guides: Vec<Option<Arc<Guide>>>,
     pub settings: ProbeSettings,
     pub layers: Layers,
     /// Also measure every strategy at the point.
@@ -34,6 +38,11 @@ impl PartialEq for ProbeRequest {
             && self.camera == o.camera
             && self.pixel == o.pixel
             && self.lanes == o.lanes
+            && self.guides.len() == o.guides.len()
+            && self.guides.iter().zip(&o.guides).all(|(a, b)| match (a, b) {
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                (a, b) => a.is_none() && b.is_none(),
+            })
             && self.settings == o.settings
             && self.layers == o.layers
             && self.table == o.table
@@ -138,8 +147,9 @@ fn serve(rx: Receiver<ProbeRequest>, slot: Arc<Mutex<Option<ProbeView>>>, notify
                     q
                 }
             };
-            for settings in &request.lanes {
-                let probe = Probe::new(request.scene.clone(), *settings);
+            for (i, settings) in request.lanes.iter().enumerate() {
+                let guide = request.guides.get(i).cloned().flatten();
+                let probe = Probe::new(request.scene.clone(), *settings).with_guide(guide);
                 let report = probe.run(&point, settings.strategy, quadrature, &request.settings);
                 let picture = probe.picture(&report, request.layers);
                 lanes.push((report, picture));

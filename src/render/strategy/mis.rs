@@ -72,7 +72,7 @@ impl Default for MisSettings {
 impl MisSettings {
     /// Whether these settings describe an estimator: two techniques other than MIS, at least one direction.
     pub fn is_valid(&self) -> bool {
-        self.techniques.iter().all(|t| t.domain() != Domain::Mixture) && self.samples.iter().sum::<u32>() > 0
+        self.techniques.iter().all(|&t| t != Strategy::Mis) && self.samples.iter().sum::<u32>() > 0
     }
 
     /// A short label: `emitter×1 + brdf×1, power`.
@@ -185,17 +185,26 @@ fn directions<S: SampleSink>(
             sink.record(SampleRecord::none(i as u8));
             continue;
         };
-        let (contribution, w, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+        let (contribution, w, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
             Ok((value, via)) => {
                 let p_other = other.pdf(&contexts[1 - i], sp, s.wi, Some(via));
                 let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
-                (value * (w / (n[i] as f32 * s.pdf)), w, Outcome::Contributed)
+                let radiance = ctx.scene.emitted(via.triangle, -s.wi);
+                (value * (w / (n[i] as f32 * s.pdf)), w, radiance, Outcome::Contributed)
             }
-            Err(outcome) => (Vec3::ZERO, 0.0, outcome),
+            Err(outcome) => {
+                // L_i = 0 along ω: weighted as if it had arrived (the weight of a zero is the record's only use).
+                let via = match s.target {
+                    super::Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
+                    super::Target::Trace => None,
+                };
+                let p_other = other.pdf(&contexts[1 - i], sp, s.wi, via);
+                (Vec3::ZERO, heuristic.weight(n[i], s.pdf, n[1 - i], p_other), Vec3::ZERO, outcome)
+            }
         };
         total += contribution;
         let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
-        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, outcome });
+        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, radiance, outcome });
     }
     total
 }
@@ -224,7 +233,7 @@ mod tests {
         let scene = crate::scene::load_scene("cornell-box").expect("bundled");
         let states = TechniqueStates([Some(Arc::new(7u32) as StrategyState), None]);
         let mis = MisSettings::default();
-        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: Some(&states) };
+        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: Some(&states), guide: None };
         assert_eq!(technique_context(&ctx, 0).state::<u32>(), Some(&7));
         assert!(technique_context(&ctx, 1).state.is_none());
         // No registered technique has state yet, so MIS prepares none.

@@ -11,6 +11,7 @@ mod brdf;
 mod brdf_polygon;
 mod cosine;
 mod emitter;
+pub mod guided;
 pub mod light;
 pub mod mis;
 mod projected_solid_angle;
@@ -24,6 +25,7 @@ pub use solid_angle::SolidAngle;
 
 use super::sink::SampleSink;
 use super::{RenderSettings, ShadingPoint};
+use crate::guiding::Guide;
 use crate::math::SampleRng;
 use crate::scene::{EmitterSampler, Scene};
 use glam::Vec3;
@@ -45,6 +47,9 @@ pub struct SampleContext<'a> {
     pub mis: &'a MisSettings,
     /// The strategy's own state, if its `prepare` made one.
     pub state: Option<&'a (dyn Any + Send + Sync)>,
+    /// The guide the renderer is learning or has learned (`guided`, alone or as a technique of MIS); it changes
+    /// only between passes.
+    pub guide: Option<&'a Guide>,
 }
 
 impl<'a> SampleContext<'a> {
@@ -92,6 +97,8 @@ pub enum Domain {
     Lights,
     /// A mixture of two techniques of either domain (MIS).
     Mixture,
+    /// A one-sample mixture of a learned guide (over the sphere), emitter sampling and BRDF sampling (`guided`).
+    Learned,
 }
 
 /// The contract every strategy implements: a (sample, pdf) pair with its name, description and formula.
@@ -235,6 +242,7 @@ registry! {
     ProjectedSolidAngle => projected_solid_angle::ProjectedSolidAngle,
     BrdfPolygon => brdf_polygon::BrdfPolygon,
     Mis => mis::Mis,
+    Guided => guided::Guided,
 }
 
 impl Strategy {
@@ -244,7 +252,13 @@ impl Strategy {
 
     /// The strategies that can be a technique of MIS: all but MIS itself.
     pub fn techniques() -> impl Iterator<Item = Strategy> {
-        Self::ALL.into_iter().filter(|s| s.domain() != Domain::Mixture)
+        Self::ALL.into_iter().filter(|&s| s != Strategy::Mis)
+    }
+
+    /// Whether rendering with `settings` learns a guide: `guided`, alone or as a technique of MIS.
+    pub fn learns(settings: &RenderSettings) -> bool {
+        settings.strategy == Strategy::Guided
+            || (settings.strategy == Strategy::Mis && settings.mis.techniques.contains(&Strategy::Guided))
     }
 
     /// Whether the strategy draws directions towards emitter triangles.

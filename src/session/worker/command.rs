@@ -44,6 +44,8 @@ pub enum Command {
     Pause(bool),
     /// Discard the films and start again (the reference stays).
     Restart,
+    /// Forget the guides `guided` learned and start learning (and the films) again.
+    ResetGuide,
     /// Render a reference at this many spp (or take it from the cache folder, and store it there when done);
     /// `None` forgets the reference.
     SetReference {
@@ -64,7 +66,11 @@ impl Command {
         match self {
             Command::SetScene(_) | Command::SetCamera(_) | Command::SetMaterial { .. } => &[A, B, R],
             // A change to either lane restarts both: under equal time they must start from zero CPU time together.
-            Command::Restart | Command::SetBudget(_) | Command::SetSettings(_) | Command::SetCompare(_) => &[A, B],
+            Command::Restart
+            | Command::ResetGuide
+            | Command::SetBudget(_)
+            | Command::SetSettings(_)
+            | Command::SetCompare(_) => &[A, B],
             Command::SetReference { .. } | Command::LoadReference(_) => &[R],
             _ => &[],
         }

@@ -1,5 +1,6 @@
 //! What the worker publishes: each lane's newest [`Frame`], and the state of the reference.
 
+use crate::guiding::{Guide, TrainingStatus};
 use crate::measure::Reference;
 use crate::render::{PassStats, RenderSettings};
 use crate::scene::Camera;
@@ -34,6 +35,8 @@ pub struct Frame {
     pub camera: Camera,
     /// A half-resolution, one-sample preview published right after a restart, before the first full pass.
     pub preview: bool,
+    /// For a strategy that learns: where its training stands and the guide its passes sample from now.
+    pub guide: Option<(TrainingStatus, Arc<Guide>)>,
 }
 
 /// The reference, as the worker last reported it.

@@ -1,5 +1,6 @@
 //! One image being refined: its settings, its film and what it took.
 
+use crate::guiding::Guide;
 use crate::render::{Film, PassStats, PixelCones, RenderSettings, Renderer};
 use crate::scene::{Camera, Scene};
 use std::sync::Arc;
@@ -20,6 +21,9 @@ pub(super) struct Lane {
     /// The renderer of its passes, kept while the scene and the settings are the same (it owns the state built
     /// per scene and settings).
     renderer: Option<Renderer>,
+    /// The guide the last renderer that learned one finished learning: a new renderer samples from it if it is
+    /// of the same light (camera, material and setting changes keep it).
+    pub(super) guide: Option<Arc<Guide>>,
 }
 
 impl Lane {
@@ -34,6 +38,7 @@ impl Lane {
             generation: 0,
             previewed: false,
             renderer: None,
+            guide: None,
         }
     }
 
@@ -44,7 +49,10 @@ impl Lane {
         match self.renderer.take() {
             Some(r) if Arc::ptr_eq(r.scene(), scene) && *r.settings() == settings => r,
             _ => {
-                let renderer = Renderer::new(scene.clone(), settings);
+                let mut renderer = Renderer::new(scene.clone(), settings);
+                if let Some(guide) = &self.guide {
+                    renderer = renderer.with_guide(guide.clone());
+                }
                 match cones {
                     Some(cones) => renderer.with_cones(cones.clone()),
                     None => renderer,
@@ -54,7 +62,16 @@ impl Lane {
     }
 
     pub(super) fn keep(&mut self, renderer: Renderer) {
+        if let Some(t) = renderer.training().filter(|t| t.is_frozen()) {
+            self.guide = Some(t.guide().clone());
+        }
         self.renderer = Some(renderer);
+    }
+
+    /// Forgets the learned guide and the renderer that holds it.
+    pub(super) fn forget_guide(&mut self) {
+        self.guide = None;
+        self.renderer = None;
     }
 
     pub(super) fn reset(&mut self, camera: &Camera, generation: u64) {

@@ -375,6 +375,7 @@ impl State {
             }
             Command::Pause(p) => self.paused = p,
             Command::Restart => {}
+            Command::ResetGuide => self.lanes.iter_mut().for_each(Lane::forget_guide),
             Command::SetReference { spp, cache } => {
                 self.reference_spp = spp;
                 self.reference_cache = cache;
@@ -418,7 +419,10 @@ impl State {
         let generation = lane.generation;
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
-        let renderer = Renderer::with_camera(self.scene.clone(), lane.settings, &small);
+        let mut renderer = Renderer::with_camera(self.scene.clone(), lane.settings, &small);
+        if let Some(guide) = &lane.guide {
+            renderer = renderer.with_guide(guide.clone());
+        }
         let mut film = Film::new(small.width, small.height);
         let stats = pool.install(|| renderer.render_pass(&mut film, 0, 1, &cancelled));
         if cancelled() {
@@ -446,6 +450,7 @@ impl State {
             scene_name: self.scene.name.clone(),
             camera,
             preview: true,
+            guide: None,
         });
     }
 
@@ -468,9 +473,10 @@ impl State {
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
         let start = Instant::now();
-        let renderer = lane.take_renderer(&self.scene, self.cones.as_ref());
+        let mut renderer = lane.take_renderer(&self.scene, self.cones.as_ref());
         let stats = pool.install(|| renderer.render_pass(&mut lane.film, lane.spp, count, &cancelled));
         self.cones = Some(renderer.cones());
+        let guide = renderer.training().map(|t| (t.status(), t.guide().clone()));
         lane.keep(renderer);
         if cancelled() {
             return; // partial: the pending command restarts this film
@@ -501,6 +507,7 @@ impl State {
             scene_name: self.scene.name.clone(),
             camera: self.scene.camera,
             preview: false,
+            guide,
         };
         self.publish(frame);
     }

@@ -1,0 +1,78 @@
+//! Path guiding for direct light: an SD-tree (Müller, Gross & Novák 2017, "Practical Path Guiding for Efficient
+//! Light-Transport Simulation") that learns where the incident radiance `L_i = L_e V` comes from at the points the
+//! camera sees, from the directions evaluated there, and gives a density over the sphere to sample it with.
+//!
+//! - [`STree`]: a binary tree over the scene's box (cycling axes); each leaf owns a [`DTree`], a quadtree over the
+//!   sphere in equal-area coordinates whose energies are sums of `L_i / p` (so its density tends to ∝ L_i).
+//! - [`Guide`]: the frozen tree a pass samples from (read-only during the pass).
+//! - [`Training`]: iteration k records the samples `2^k − 1 .. 2^(k+1) − 1` of every pixel into the sums of a
+//!   tree shaped by iteration k − 1's, then builds the next guide from them; after the training budget the guide
+//!   is frozen. Sums are fixed-point integers, so the guide is the same whatever the order of the records (any
+//!   thread count, any split into passes).
+//!
+//! Written from the paper (whose code is GPL-3: none is copied). Left out: the stochastic spatial filter and
+//! the learned BSDF/guide mixing weight (Müller's later "improved" variant); the guide learns light only, so a
+//! change of camera or material keeps it.
+
+mod dtree;
+mod stree;
+mod training;
+
+pub use dtree::{DTree, Shape, Sums, dir_to_square, square_to_dir};
+pub use stree::STree;
+pub use training::{GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
+
+use glam::Vec3;
+
+/// A frozen SD-tree: where each point's quadtree is, and the quadtrees.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Guide {
+    pub stree: STree,
+    pub dtrees: Vec<DTree>,
+    /// Which scene's light it learned: [`light_fingerprint`] of that scene.
+    pub fingerprint: u64,
+}
+
+impl Guide {
+    /// A guide with no energy (no density anywhere) over the box `lo..hi`.
+    pub fn empty(lo: Vec3, hi: Vec3, fingerprint: u64) -> Self {
+        Self { stree: STree::new(lo, hi), dtrees: vec![DTree::default()], fingerprint }
+    }
+
+    /// The quadtree of the leaf holding `p`.
+    #[inline]
+    pub fn dtree(&self, p: Vec3) -> &DTree {
+        &self.dtrees[self.stree.leaf(p) as usize]
+    }
+
+    /// Quadtree nodes over all leaves.
+    pub fn dtree_nodes(&self) -> usize {
+        self.dtrees.iter().map(|d| d.shape().nodes()).sum()
+    }
+
+    /// Bytes the guide occupies.
+    pub fn bytes(&self) -> usize {
+        self.dtrees.iter().map(DTree::bytes).sum::<usize>() + self.stree.nodes() * 8
+    }
+
+    /// Whether any leaf has a density.
+    pub fn is_usable(&self) -> bool {
+        self.dtrees.iter().any(DTree::is_usable)
+    }
+}
+
+/// A hash of what a guide learns: the triangles' positions and each triangle's emitted radiance. Equal for a
+/// scene whose camera or non-emitting materials changed; different when geometry or light did.
+pub fn light_fingerprint(scene: &crate::scene::Scene) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for (i, t) in scene.triangles.iter().enumerate() {
+        for v in t.v {
+            v.to_array().map(f32::to_bits).hash(&mut h);
+        }
+        let n = t.n;
+        scene.emitted(i as u32, n).to_array().map(f32::to_bits).hash(&mut h);
+        scene.emitted(i as u32, -n).to_array().map(f32::to_bits).hash(&mut h);
+    }
+    h.finish()
+}

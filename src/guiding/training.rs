@@ -1,0 +1,265 @@
+//! Learning the guide, iteration by iteration (Müller et al. 2017, §3.4): iteration k takes the samples
+//! `2^k − 1 .. 2^(k+1) − 1` of every pixel (1, 2, 4, … samples per pixel), sampled with the guide built from
+//! iteration k − 1 (none for k = 0), and records each evaluated direction into the sums of a tree shaped by that
+//! guide. At the end of the iteration the sums become the next guide: leaves that received more than
+//! `c √(2^k)` records are split, and each quadtree is refined where a quadrant holds more than 1% of its energy.
+//! Iterations that end within the training budget learn; after them the guide is frozen.
+//!
+//! A pass is unbiased given the frozen guide it samples from, so every pass may be kept. The guide is a function
+//! of the records only, summed in fixed point: the same for any order, so for any thread count and any split
+//! into passes, provided every sample of an iteration is recorded exactly once. A pass that does not continue
+//! the iteration where the last one stopped (a restart) starts the iteration's records again.
+
+use super::{DTree, Guide, STree, Sums, light_fingerprint};
+use crate::scene::Scene;
+use glam::{Vec2, Vec3};
+use std::ops::Range;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// A quadrant holding more than this share of a quadtree's energy is split for the next iteration.
+const ENERGY_THRESHOLD: f64 = 0.01;
+/// Quadtree levels at most (Müller's 20).
+const MAX_DTREE_DEPTH: usize = 20;
+/// Spatial tree levels at most.
+const MAX_STREE_DEPTH: usize = 30;
+
+/// How a guide learns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct GuideSettings {
+    /// Samples per pixel of training: the iterations that end within it learn, then the guide is frozen.
+    pub training_spp: u32,
+    /// Müller's c: a spatial leaf with more than `c √(2^k)` records in iteration k is split.
+    pub spatial_threshold: u32,
+    /// Leave the training samples out of the image (they are unbiased, but noisier).
+    pub discard_training: bool,
+}
+
+impl Default for GuideSettings {
+    fn default() -> Self {
+        Self { training_spp: 64, spatial_threshold: 4000, discard_training: false }
+    }
+}
+
+impl GuideSettings {
+    /// Samples `0..training_end()` are taken while learning.
+    pub fn training_end(&self) -> u32 {
+        (0..32).map(iteration_samples).take_while(|r| r.end <= self.training_spp).last().map_or(0, |r| r.end)
+    }
+}
+
+/// The samples of every pixel that iteration k records: `2^k − 1 .. 2^(k+1) − 1`.
+pub fn iteration_samples(k: u32) -> Range<u32> {
+    let start = (1u64 << k) - 1;
+    start.min(u32::MAX as u64) as u32..((1u64 << (k + 1)) - 1).min(u32::MAX as u64) as u32
+}
+
+/// One recorded direction: the spatial leaf of its point, its square point, and `L_i / p` (luminance).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GuideRecord {
+    pub leaf: u32,
+    pub square: Vec2,
+    pub value: f32,
+}
+
+/// What one iteration built.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationReport {
+    pub iteration: u32,
+    /// Samples per pixel learned from by the end of this iteration.
+    pub spp: u32,
+    pub records: u64,
+    pub leaves: usize,
+    pub dtree_nodes: usize,
+    pub bytes: usize,
+    pub build: Duration,
+}
+
+/// Where the training stands, for the viewer's status line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrainingStatus {
+    /// The guide was learned before (kept across a camera or material change), not by this render.
+    pub kept: bool,
+    /// The iteration being recorded (or, when frozen, the number of iterations).
+    pub iteration: u32,
+    /// Samples per pixel the current guide learned from.
+    pub learned_spp: u32,
+    pub frozen: bool,
+    pub leaves: usize,
+    pub dtree_nodes: usize,
+    pub bytes: usize,
+    /// The last iteration's build time.
+    pub build: Duration,
+}
+
+/// A guide being learned.
+#[derive(Clone, Debug)]
+pub struct Training {
+    settings: GuideSettings,
+    guide: Arc<Guide>,
+    /// Per leaf of the guide's spatial tree: the records of the current iteration.
+    sums: Vec<Sums>,
+    iteration: u32,
+    /// The sample the current iteration's records continue from.
+    next: u32,
+    log: Vec<IterationReport>,
+    /// Learned before this training began ([`Training::kept`]): frozen from the start.
+    kept: bool,
+}
+
+impl Training {
+    /// Starts with no guide, over the scene's box.
+    pub fn new(scene: &Scene, settings: GuideSettings) -> Self {
+        let (lo, hi) = scene
+            .triangles
+            .iter()
+            .flat_map(|t| t.v)
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let (lo, hi) = if lo.cmple(hi).all() { (lo, hi) } else { (Vec3::ZERO, Vec3::ONE) };
+        Self::from_guide(Arc::new(Guide::empty(lo, hi, light_fingerprint(scene))), settings)
+    }
+
+    fn from_guide(guide: Arc<Guide>, settings: GuideSettings) -> Self {
+        let sums = guide.dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
+        Self { settings, guide, sums, iteration: 0, next: 0, log: Vec::new(), kept: false }
+    }
+
+    /// A guide learned earlier (e.g. kept across a camera change), used as it is: it learns no more.
+    pub fn kept(guide: Arc<Guide>, settings: GuideSettings) -> Self {
+        Self { kept: true, ..Self::from_guide(guide, settings) }
+    }
+
+    /// The guide passes sample from now.
+    pub fn guide(&self) -> &Arc<Guide> {
+        &self.guide
+    }
+
+    pub fn settings(&self) -> &GuideSettings {
+        &self.settings
+    }
+
+    /// Whether the guide no longer learns.
+    pub fn is_frozen(&self) -> bool {
+        self.kept || iteration_samples(self.iteration).end > self.settings.training_spp
+    }
+
+    /// Whether its guide was learned before it began.
+    pub fn is_kept(&self) -> bool {
+        self.kept
+    }
+
+    /// What each iteration built.
+    pub fn log(&self) -> &[IterationReport] {
+        &self.log
+    }
+
+    pub fn status(&self) -> TrainingStatus {
+        let last = self.log.last();
+        TrainingStatus {
+            kept: self.kept,
+            iteration: self.iteration,
+            learned_spp: last.map_or(0, |r| r.spp),
+            frozen: self.is_frozen(),
+            leaves: self.guide.stree.leaves(),
+            dtree_nodes: self.guide.dtree_nodes(),
+            bytes: self.guide.bytes(),
+            build: last.map_or(Duration::ZERO, |r| r.build),
+        }
+    }
+
+    /// How to take samples `first..end`: the first `stop − first` of them, recording them or not. A range that
+    /// learns never crosses an iteration's end, so the guide changes only between ranges.
+    pub fn plan(&mut self, first: u32, end: u32) -> (u32, bool) {
+        if self.is_frozen() {
+            return (end, false);
+        }
+        let samples = iteration_samples(self.iteration);
+        if first != self.next {
+            // A restart or a gap: this iteration's records start again from its first sample.
+            self.sums.iter_mut().for_each(|s| *s = Sums::new(s.shape().clone()));
+            self.next = samples.start;
+        }
+        if first < samples.start {
+            (end.min(samples.start), false)
+        } else if first == self.next {
+            (end.min(samples.end), true)
+        } else {
+            (end, false)
+        }
+    }
+
+    /// Takes the records of samples `self.next..until` (a range [`Training::plan`] said to record); builds the
+    /// next guide when they complete the iteration.
+    pub fn learn(&mut self, records: impl IntoIterator<Item = GuideRecord>, until: u32) {
+        for r in records {
+            if let Some(sums) = self.sums.get_mut(r.leaf as usize) {
+                sums.record(r.square, r.value);
+            }
+        }
+        self.next = until;
+        if until == iteration_samples(self.iteration).end {
+            self.build();
+        }
+    }
+
+    /// The next guide from this iteration's sums.
+    fn build(&mut self) {
+        let start = Instant::now();
+        let records: u64 = self.sums.iter().map(|s| s.records).sum();
+        let densities: Vec<DTree> = self.sums.iter().map(Sums::density).collect();
+        let counts: Vec<u64> = self.sums.iter().map(|s| s.records).collect();
+        let mut stree: STree = self.guide.stree.clone();
+        let threshold = self.settings.spatial_threshold as f64 * (self.iteration as f64).exp2().sqrt();
+        let parents = stree.split(&counts, threshold, MAX_STREE_DEPTH);
+        let dtrees: Vec<DTree> = parents.iter().map(|&p| densities[p as usize].clone()).collect();
+        self.sums = dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
+        self.guide = Arc::new(Guide { stree, dtrees, fingerprint: self.guide.fingerprint });
+        self.log.push(IterationReport {
+            iteration: self.iteration,
+            spp: iteration_samples(self.iteration).end,
+            records,
+            leaves: self.guide.stree.leaves(),
+            dtree_nodes: self.guide.dtree_nodes(),
+            bytes: self.guide.bytes(),
+            build: start.elapsed(),
+        });
+        self.iteration += 1;
+        self.next = iteration_samples(self.iteration).start;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn iterations_double() {
+        let ranges: Vec<_> = (0..4).map(iteration_samples).collect();
+        assert_eq!(ranges, vec![0..1, 1..3, 3..7, 7..15]);
+        assert_eq!(GuideSettings { training_spp: 64, ..Default::default() }.training_end(), 63);
+        assert_eq!(GuideSettings { training_spp: 16, ..Default::default() }.training_end(), 15);
+        assert_eq!(GuideSettings { training_spp: 0, ..Default::default() }.training_end(), 0);
+    }
+
+    /// Passes split anywhere learn at the same samples; a restart records the iteration again.
+    #[test]
+    fn plans_follow_the_iterations() {
+        let scene = crate::scene::load_scene("cornell-box").expect("bundled");
+        let mut t = Training::new(&scene, GuideSettings { training_spp: 8, ..Default::default() });
+        assert_eq!(t.plan(0, 13), (1, true));
+        t.learn([], 1);
+        assert_eq!(t.plan(1, 2), (2, true));
+        t.learn([], 2);
+        assert_eq!(t.plan(2, 13), (3, true));
+        t.learn([], 3);
+        // A restart at 0 while iteration 2 (samples 3..7) is due: 0..3 with the guide, then learn from 3.
+        assert_eq!(t.plan(0, 5), (3, false));
+        assert_eq!(t.plan(3, 5), (5, true));
+        t.learn([], 5);
+        assert_eq!(t.plan(5, 13), (7, true));
+        t.learn([], 7);
+        assert!(t.is_frozen(), "iteration 3 would end at 15 > 8");
+        assert_eq!(t.plan(7, 13), (13, false));
+        assert_eq!(t.log().len(), 3);
+    }
+}

@@ -1,0 +1,136 @@
+//! Guided sampling (path guiding for direct light; Müller, Gross & Novák 2017): a one-sample mixture of the
+//! learned guide, emitter sampling and BRDF sampling,
+//!
+//! `p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω)`,  (c_g, c_l, c_b) = (½, ¼, ¼),
+//!
+//! where p_guide is the quadtree density of the spatial leaf holding the shading point ([`crate::guiding`]),
+//! which the renderer learns from the directions evaluated at the points the camera sees. Where the leaf has
+//! learned nothing (and before any guide exists) c_g = 0 and the others share its weight; where the scene has
+//! no emitters c_l = 0. Since c_l + c_b > 0 wherever f_r L_i (ω·n) > 0 can be, the estimator
+//! `f_r L_i (ω·n) / p(ω)` stays unbiased whatever the guide learned. The guide learns light only (`L_e V`), not
+//! the BRDF: a change of camera or material keeps it.
+
+use super::brdf::Brdf;
+use super::emitter::Emitter;
+use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Target, Technique};
+use crate::math::SampleRng;
+use crate::render::ShadingPoint;
+use crate::render::estimator::{integrand, reached};
+use crate::render::sink::{Outcome, SampleRecord, SampleSink};
+use glam::Vec3;
+
+/// The mixture's weights where the guide has a density: guide, light, BRDF.
+pub const WEIGHTS: [f32; 3] = [0.5, 0.25, 0.25];
+
+pub struct Guided;
+
+/// The weights (c_g, c_l, c_b) at a shading point: [`WEIGHTS`] with the parts that cannot sample there left out
+/// and the rest scaled to sum to one.
+#[inline]
+pub fn weights(ctx: &SampleContext, sp: &ShadingPoint) -> [f32; 3] {
+    let guide = ctx.guide.is_some_and(|g| g.dtree(sp.p).is_usable());
+    let [g, l, b] = WEIGHTS;
+    let w = [if guide { g } else { 0.0 }, if ctx.emitters.is_some() { l } else { 0.0 }, b];
+    let sum = w[0] + w[1] + w[2];
+    w.map(|c| c / sum)
+}
+
+/// Which part draws, from one uniform.
+#[inline]
+fn choose(w: &[f32; 3], u: f32) -> usize {
+    if u < w[0] {
+        0
+    } else if u < w[0] + w[1] || w[2] == 0.0 {
+        1
+    } else {
+        2
+    }
+}
+
+impl Guided {
+    /// A direction from the part chosen, with that part's own density (the estimator divides by the mixture's).
+    #[inline]
+    fn sample_part(ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<(DirectionSample, [f32; 3])> {
+        let w = weights(ctx, sp);
+        let s = match choose(&w, rng.uniform()) {
+            0 => {
+                let dtree = ctx.guide?.dtree(sp.p);
+                let wi = dtree.sample(rng)?;
+                DirectionSample { wi, pdf: dtree.pdf(wi), target: Target::Trace }
+            }
+            1 => Technique::sample(&Emitter, ctx, sp, rng)?,
+            _ => Technique::sample(&Brdf, ctx, sp, rng)?,
+        };
+        Some((s, w))
+    }
+
+    /// The mixture's density with the weights `w` at `sp`.
+    #[inline]
+    fn mixture_pdf(ctx: &SampleContext, sp: &ShadingPoint, w: &[f32; 3], wi: Vec3, via: Option<Reached>) -> f32 {
+        let guide = match ctx.guide {
+            Some(g) if w[0] > 0.0 => g.dtree(sp.p).pdf(wi),
+            _ => 0.0,
+        };
+        let light = if w[1] > 0.0 { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
+        w[0] * guide + w[1] * light + w[2] * Technique::pdf(&Brdf, ctx, sp, wi, via)
+    }
+}
+
+impl DirectionStrategy for Guided {
+    const NAME: &'static str = "guided";
+    const DESCRIPTION: &'static str =
+        "path guiding: a learned SD-tree of incident light, mixed with emitter and BRDF sampling (Müller 2017)";
+    const PDF: &'static str = "p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω),  c = (½, ¼, ¼)";
+    const DOMAIN: Domain = Domain::Learned;
+
+    /// A direction of the mixture with the mixture's density (which, for a direction the guide or the BRDF
+    /// drew, needs the emitter triangle it reaches: one more ray).
+    fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
+        let (s, w) = Self::sample_part(ctx, sp, rng)?;
+        let via = match s.target {
+            Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
+            Target::Trace => reached(ctx.scene, sp, s.wi),
+        };
+        let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, via);
+        (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { pdf, ..s })
+    }
+
+    fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        Self::mixture_pdf(ctx, sp, &weights(ctx, sp), wi, via)
+    }
+
+    /// `f_r L_i (ω·n) / p(ω)` with the mixture's density, found after L_i (the ray the estimator traces anyway
+    /// tells which emitter triangle ω reaches).
+    #[inline]
+    fn estimate<S: SampleSink>(
+        &self,
+        ctx: &SampleContext,
+        sp: &ShadingPoint,
+        rng: &mut SampleRng,
+        rays: &mut u64,
+        sink: &mut S,
+    ) -> Vec3 {
+        let Some((s, w)) = Self::sample_part(ctx, sp, rng) else {
+            sink.record(SampleRecord::none(0));
+            return Vec3::ZERO;
+        };
+        let (contribution, pdf, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+            Ok((value, via)) => {
+                let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, Some(via));
+                let radiance = ctx.scene.emitted(via.triangle, -s.wi);
+                (value / pdf, pdf, radiance, Outcome::Contributed)
+            }
+            Err(outcome) => {
+                // An occluded or missed direction still tells the guide something: L_i = 0 there.
+                let via = match s.target {
+                    Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
+                    Target::Trace => None,
+                };
+                let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, via);
+                (Vec3::ZERO, pdf, Vec3::ZERO, outcome)
+            }
+        };
+        sink.record(SampleRecord { technique: 0, wi: s.wi, pdf, mis_weight: 1.0, contribution, radiance, outcome });
+        contribution
+    }
+}
