@@ -45,13 +45,11 @@ fn quadrature_matches_lambert_at_unoccluded_diffuse_points() {
 
 /// The points the checks probe: per bundled scene, the first pixel (scanning a 48×36 image) that is lit with
 /// nothing in the way, one in a penumbra, a lit glossy one (the brightest under BRDF sampling, which puts its
-/// light near ω_r), and a lit one seen at grazing angle; those a scene has. Where no point is lit with nothing in
-/// the way (occluded-light: the light shows through a small hole), the first point that sees some light through
-/// an opening (at least 80% of the shadow rays blocked).
+/// light near ω_r), and a lit one seen at grazing angle; those a scene has.
 fn probed_points(probe: &Probe) -> Vec<(&'static str, ProbePoint)> {
     let scene = probe.scene();
     let ctx = probe.context();
-    let (mut lit, mut penumbra, mut grazing, mut opening) = (None, None, None, None);
+    let (mut lit, mut penumbra, mut grazing) = (None, None, None);
     let mut glossy: Option<(f64, ProbePoint)> = None;
     for y in (0..scene.camera.height).step_by(2) {
         for x in (0..scene.camera.width).step_by(2) {
@@ -70,9 +68,6 @@ fn probed_points(probe: &Probe) -> Vec<(&'static str, ProbePoint)> {
             if occluded == 0 && lit.is_none() {
                 lit = Some(point);
             }
-            if fraction >= 0.8 && opening.is_none() {
-                opening = Some(point);
-            }
             if (0.2..0.8).contains(&fraction) && penumbra.is_none() {
                 penumbra = Some(point);
             }
@@ -87,8 +82,7 @@ fn probed_points(probe: &Probe) -> Vec<(&'static str, ProbePoint)> {
             }
         }
     }
-    let opening = opening.filter(|_| lit.is_none());
-    [("lit", lit), ("penumbra", penumbra), ("glossy", glossy.map(|g| g.1)), ("grazing", grazing), ("opening", opening)]
+    [("lit", lit), ("penumbra", penumbra), ("glossy", glossy.map(|g| g.1)), ("grazing", grazing)]
         .into_iter()
         .filter_map(|(k, p)| p.map(|p| (k, p)))
         .collect()
@@ -111,7 +105,10 @@ fn every_strategy_matches_the_quadrature_at_probed_points() {
     for b in BUNDLED_SCENES {
         let probe = Probe::new(small(b.name), RenderSettings::default());
         let points = probed_points(&probe);
-        assert!(points.iter().any(|(k, _)| *k == "lit" || *k == "opening"), "{}: no lit point", b.name);
+        // occluded-light has no point lit with nothing in the way (the light shows through a small hole), and there
+        // the quadrature at this budget is too coarse to judge by (0.1639 where emitter, MIS and guided agree on
+        // 0.1548 ± 0.0005 with 2·10⁶ samples each); tests/guided.rs checks the strategies there against emitter.
+        assert!(points.iter().any(|(k, _)| *k == "lit") || b.name == "occluded-light", "{}: no lit point", b.name);
         for (kind, point) in points {
             let q = probe.quadrature(&point, &ProbeSettings { quadrature_nodes: 2_000_000, ..Default::default() });
             let truth = luminance(q.value) as f64;

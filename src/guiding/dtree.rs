@@ -36,10 +36,16 @@ pub fn dir_to_square(w: Vec3) -> Vec2 {
 /// The unit direction of the square point `s`: [`dir_to_square`]'s inverse.
 #[inline]
 pub fn square_to_dir(s: Vec2) -> Vec3 {
+    square_to_dir_f64(s.as_dvec2())
+}
+
+/// [`square_to_dir`] from a point in f64, rounded once at the end (a deep leaf is only a few f32 steps wide).
+#[inline]
+fn square_to_dir_f64(s: DVec2) -> Vec3 {
     let cos_theta = 2.0 * s.x - 1.0;
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = (TAU * s.y).sin_cos();
-    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
+    let (sin_phi, cos_phi) = (std::f64::consts::TAU * s.y).sin_cos();
+    glam::DVec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta).as_vec3()
 }
 
 /// Quadrant q of a node's square: bit 0 is the right half (x ≥ ½), bit 1 the upper half (y ≥ ½).
@@ -105,6 +111,18 @@ impl Shape {
         self.nodes.len()
     }
 
+    /// The side of the leaf holding square point `s`.
+    pub fn leaf_side(&self, s: Vec2) -> f32 {
+        let (mut node, mut s, mut side) = (0usize, s.as_dvec2(), 0.5f32);
+        loop {
+            let (q, local) = quadrant(s);
+            match self.nodes[node].children[q] {
+                0 => return side,
+                child => (node, s, side) = (child as usize, local, side * 0.5),
+            }
+        }
+    }
+
     pub fn depth(&self) -> usize {
         fn depth(shape: &Shape, node: usize) -> usize {
             1 + shape.nodes[node]
@@ -142,8 +160,52 @@ impl Sums {
     #[inline]
     pub fn record(&mut self, s: Vec2, value: f32) {
         let (node, q) = self.shape.leaf(s);
-        self.sums[node][q] += fixed_point(value);
+        self.sums[node][q] = self.sums[node][q].saturating_add(fixed_point(value));
         self.records += 1;
+    }
+
+    /// Adds `value` spread evenly over a square as wide as the leaf holding `s`, centred on `s` (Müller et al.
+    /// 2019's directional box filter: a record informs the cells around its own, so that few records cover an
+    /// opening's directions without holes). The square wraps around in φ and is cut at the poles (the energy
+    /// stays whole). Leaves receive their share of the square's area.
+    pub fn record_filtered(&mut self, s: Vec2, value: f32) {
+        let side = self.shape.leaf_side(s) as f64;
+        let (lo, hi) = (s.as_dvec2() - side * 0.5, s.as_dvec2() + side * 0.5);
+        let (x0, x1) = (lo.x.max(0.0), hi.x.min(1.0));
+        // φ wraps: the square's part below 0 or above 1 comes in from the other side.
+        let mut pieces = [(lo.y.max(0.0), hi.y.min(1.0)), (0.0, 0.0)];
+        if lo.y < 0.0 {
+            pieces[1] = (lo.y + 1.0, 1.0);
+        } else if hi.y > 1.0 {
+            pieces[1] = (0.0, hi.y - 1.0);
+        }
+        let area = (x1 - x0) * side;
+        self.records += 1;
+        if !(area > 0.0) || !(value > 0.0) {
+            return;
+        }
+        for (y0, y1) in pieces.into_iter().filter(|(a, b)| b > a) {
+            self.splat(0, DVec2::ZERO, 1.0, (DVec2::new(x0, y0), DVec2::new(x1, y1)), value as f64 / area);
+        }
+    }
+
+    /// Adds `density` × (area of the box within each leaf) below `node` (square at `corner`, side `side`).
+    fn splat(&mut self, node: usize, corner: DVec2, side: f64, (lo, hi): (DVec2, DVec2), density: f64) {
+        let half = side * 0.5;
+        for q in 0..4 {
+            let c = corner + DVec2::new((q & 1) as f64, (q >> 1) as f64) * half;
+            let (a, b) = (lo.max(c), hi.min(c + half));
+            if b.x <= a.x || b.y <= a.y {
+                continue;
+            }
+            match self.shape.nodes[node].children[q] {
+                0 => {
+                    let e = fixed_point((density * (b.x - a.x) * (b.y - a.y)) as f32);
+                    self.sums[node][q] = self.sums[node][q].saturating_add(e);
+                }
+                child => self.splat(child as usize, c, half, (lo, hi), density),
+            }
+        }
     }
 
     /// The density the sums describe: each node's quadrant energies summed up from its leaves.
@@ -157,7 +219,7 @@ impl Sums {
                     child => total(sums, energy, child as usize),
                 };
                 energy[node][q] = e as f64 * (-FRACTION_BITS as f64).exp2();
-                sum += e;
+                sum = sum.saturating_add(e);
             }
             sum
         }
@@ -248,10 +310,11 @@ impl DTree {
     }
 
     /// Draws a direction: a quadrant per level in proportion to its energy (one uniform per level), then a
-    /// uniform point of the leaf (two more). `None` when the tree has no energy.
+    /// uniform point of the leaf (two more); with the density of the leaf drawn from (which [`DTree::pdf`] gives
+    /// too, but for a direction within rounding of a leaf's edge). `None` when the tree has no energy.
     #[inline]
-    pub fn sample(&self, rng: &mut SampleRng) -> Option<Vec3> {
-        let (mut node, mut corner, mut side) = (0usize, DVec2::ZERO, 1.0f64);
+    pub fn sample(&self, rng: &mut SampleRng) -> Option<(Vec3, f32)> {
+        let (mut node, mut corner, mut side, mut p) = (0usize, DVec2::ZERO, 1.0f64, 1.0f64);
         loop {
             let e = &self.energy[node];
             let total = e[0] + e[1] + e[2] + e[3];
@@ -268,11 +331,12 @@ impl DTree {
             }
             side *= 0.5;
             corner += DVec2::new((q & 1) as f64, (q >> 1) as f64) * side;
+            p *= 4.0 * e[q] / total;
             match self.shape.nodes[node].children[q] {
                 0 => {
                     let u = rng.uniform_2d().as_dvec2();
                     let s = (corner + u * side).min(DVec2::splat(1.0 - f64::EPSILON));
-                    return Some(square_to_dir(s.as_vec2()));
+                    return Some((square_to_dir_f64(s), (p * INV_FOUR_PI as f64) as f32));
                 }
                 child => node = child as usize,
             }
@@ -377,6 +441,22 @@ mod tests {
         assert!((forward.density().total() - total).abs() < 1e-9 * total);
     }
 
+    /// The filtered record keeps its whole value, spreads it over the cells around its own, and wraps in φ.
+    #[test]
+    fn filtered_records_keep_their_energy() {
+        let shape = Shape::uniform(4); // leaves of side 1/8
+        let mut sums = Sums::new(shape.clone());
+        sums.record_filtered(Vec2::new(0.5, 0.99), 8.0); // straddles φ = 1 and four leaves
+        let d = sums.density();
+        assert!((d.total() - 8.0).abs() < 1e-9, "{}", d.total());
+        let filled = shape.leaves().iter().filter(|(c, side)| d.pdf(square_to_dir(*c + *side * 0.5)) > 0.0).count();
+        assert_eq!(filled, 4, "two leaves across cos θ, two across the φ seam");
+        // At a pole the square is cut and the energy stays whole.
+        let mut sums = Sums::new(shape);
+        sums.record_filtered(Vec2::new(0.01, 0.3), 2.0);
+        assert!((sums.density().total() - 2.0).abs() < 1e-9);
+    }
+
     /// ∫ pdf dω = 1 over the sphere, by the midpoint rule on a fine square grid, for trees of every kind.
     #[test]
     fn the_density_integrates_to_one() {
@@ -429,6 +509,10 @@ mod tests {
         let tree = DTree::default();
         assert_eq!(tree.pdf(Vec3::Z), 0.0);
         assert!(tree.sample(&mut SampleRng::new(0, 0, 0)).is_none());
+        let mut sums = Sums::new(Shape::default());
+        sums.sums[0][0] = u128::MAX - 1;
+        sums.record(Vec2::splat(0.1), f32::MAX);
+        assert_eq!(sums.sums[0][0], u128::MAX, "sums saturate");
         assert_eq!(fixed_point(f32::NAN), 0);
         assert_eq!(fixed_point(-1.0), 0);
         assert_eq!(fixed_point(f32::INFINITY), 0);

@@ -10,15 +10,18 @@
 //!   is frozen. Sums are fixed-point integers, so the guide is the same whatever the order of the records (any
 //!   thread count, any split into passes).
 //!
-//! Written from the paper (whose code is GPL-3: none is copied). Left out: the stochastic spatial filter and
-//! the learned BSDF/guide mixing weight (Müller's later "improved" variant); the guide learns light only, so a
-//! change of camera or material keeps it.
+//! Records are splatted with Müller's box filters, spatially (a jittered position within the leaf's box) and
+//! over directions (a square as wide as the record's quadtree leaf), and each leaf learns its mixture weights
+//! (see [`mixture`]). Written from the papers (whose code is GPL-3: none is copied). The guide learns light
+//! only, so a change of camera or material keeps it.
 
 mod dtree;
+mod mixture;
 mod stree;
 mod training;
 
 pub use dtree::{DTree, Shape, Sums, dir_to_square, square_to_dir};
+pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
 pub use stree::STree;
 pub use training::{GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
 
@@ -28,21 +31,37 @@ use glam::Vec3;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Guide {
     pub stree: STree,
+    /// Per spatial leaf: the quadtree.
     pub dtrees: Vec<DTree>,
+    /// Per spatial leaf: the mixture weights (c_g, c_l, c_b) `guided` samples with there.
+    pub weights: Vec<[f32; 3]>,
     /// Which scene's light it learned: [`light_fingerprint`] of that scene.
     pub fingerprint: u64,
 }
 
 impl Guide {
+    /// A guide of the given leaves' quadtrees, with the default mixture weights everywhere.
+    pub fn new(stree: STree, dtrees: Vec<DTree>, fingerprint: u64) -> Self {
+        let weights = vec![DEFAULT_WEIGHTS; dtrees.len()];
+        Self { stree, dtrees, weights, fingerprint }
+    }
+
     /// A guide with no energy (no density anywhere) over the box `lo..hi`.
     pub fn empty(lo: Vec3, hi: Vec3, fingerprint: u64) -> Self {
-        Self { stree: STree::new(lo, hi), dtrees: vec![DTree::default()], fingerprint }
+        Self::new(STree::new(lo, hi), vec![DTree::default()], fingerprint)
     }
 
     /// The quadtree of the leaf holding `p`.
     #[inline]
     pub fn dtree(&self, p: Vec3) -> &DTree {
         &self.dtrees[self.stree.leaf(p) as usize]
+    }
+
+    /// The quadtree and the mixture weights of the leaf holding `p`.
+    #[inline]
+    pub fn leaf(&self, p: Vec3) -> (&DTree, [f32; 3]) {
+        let leaf = self.stree.leaf(p) as usize;
+        (&self.dtrees[leaf], self.weights[leaf])
     }
 
     /// Quadtree nodes over all leaves.

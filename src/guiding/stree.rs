@@ -57,6 +57,25 @@ impl STree {
         }
     }
 
+    /// The leaf holding `p` and its box's size.
+    #[inline]
+    pub fn leaf_extent(&self, p: Vec3) -> (u32, Vec3) {
+        let mut x = ((p - self.origin) / self.side).clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
+        let (mut node, mut axis, mut size) = (0usize, 0usize, Vec3::splat(self.side));
+        loop {
+            match self.nodes[node] {
+                SNode::Leaf(leaf) => return (leaf, size),
+                SNode::Inner(children) => {
+                    let upper = x[axis] >= 0.5;
+                    x[axis] = if upper { x[axis] * 2.0 - 1.0 } else { x[axis] * 2.0 };
+                    size[axis] *= 0.5;
+                    node = children[upper as usize] as usize;
+                    axis = (axis + 1) % 3;
+                }
+            }
+        }
+    }
+
     /// Splits every leaf whose count exceeds `threshold`, and each half again while half the count exceeds it
     /// (Müller's halving of the statistical weight), keeping the tree at most `max_depth` levels deep. Returns,
     /// per new leaf, the old leaf it came from (whose quadtree it starts from).

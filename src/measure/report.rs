@@ -139,16 +139,17 @@ pub fn markdown(report: &BenchReport, ctx: &BenchContext) -> String {
     for (strategy, log) in &report.guides {
         let _ = writeln!(
             md,
-            "\n{strategy}'s guide, per training iteration: spp learned from, records, spatial leaves, quadtree \
-             nodes, KiB, build ms:"
+            "\n{strategy}'s guide, per training iteration: spp learned from, records, ms to learn them, spatial \
+             leaves, quadtree nodes, KiB, build ms:"
         );
         for r in log {
             let _ = writeln!(
                 md,
-                "- {}: {} spp, {} records, {} leaves, {} nodes, {:.1} KiB, {:.1} ms",
+                "- {}: {} spp, {} records, {:.1} ms, {} leaves, {} nodes, {:.1} KiB, {:.1} ms",
                 r.iteration,
                 r.spp,
                 r.records,
+                r.learn.as_secs_f64() * 1e3,
                 r.leaves,
                 r.dtree_nodes,
                 r.bytes as f64 / 1024.0,

@@ -45,7 +45,8 @@ pub fn one_sample<S: SampleSink>(
         Err(outcome) => (Vec3::ZERO, Vec3::ZERO, outcome),
     };
     let (wi, pdf) = (s.wi, s.pdf);
-    sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome });
+    let parts = [0.0; 3];
+    sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts });
     contribution
 }
 

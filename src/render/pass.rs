@@ -6,8 +6,8 @@ use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
 use super::sink::{SampleRecord, SampleSink};
 use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
-use crate::guiding::{Guide, GuideRecord, GuideSettings, Training, dir_to_square};
-use crate::math::{PixelStreams, SampleRng, luminance};
+use crate::guiding::{Guide, GuideRecord, GuideSettings, MixtureSample, STree, Training, dir_to_square};
+use crate::math::{PixelStreams, SampleRng, luminance, mix64};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
@@ -186,7 +186,8 @@ impl Renderer {
                 None => (end, false),
             };
             let training_end = self.settings.guiding.training_end();
-            let keep = !(self.training.is_some() && self.settings.guiding.discard_training && s < training_end);
+            let trains = self.training.as_ref().is_some_and(|t| !t.is_kept());
+            let keep = !(trains && self.settings.guiding.discard_training && s < training_end);
             if !keep {
                 stop = stop.min(training_end);
             }
@@ -399,7 +400,10 @@ impl Renderer {
         let (strategy, ctx) = (self.settings.strategy, self.context());
         let estimate = match (learned, ctx.guide) {
             (Some(out), Some(guide)) => {
-                let mut learner = Learner { leaf: guide.stree.leaf(sp.p), out };
+                // MIS divides technique i's directions by n_i; one-sample strategies take one (technique 0).
+                let samples = if strategy == Strategy::Mis { ctx.mis.samples } else { [1, 1] };
+                let (_, extent) = guide.stree.leaf_extent(sp.p);
+                let mut learner = Learner { stree: &guide.stree, p: sp.p, extent, samples, out };
                 strategy.estimate(&ctx, &sp, rng, rays, &mut learner)
             }
             _ => strategy.estimate(&ctx, &sp, rng, rays, &mut ()),
@@ -432,10 +436,20 @@ impl SampleSink for Census {
 }
 
 /// The sink of a pass that learns: every direction along which L_i was found becomes a guide record of the
-/// shading point's spatial leaf, valued `w L_i / p` (luminance; w the MIS weight, 1 outside MIS): an unbiased
-/// estimate of ∫ L_i over the direction's cell, whichever technique drew it.
+/// shading point's spatial leaf, valued `w L_i / (n_i p_i)` (luminance; w the MIS weight and n_i the directions
+/// of its technique, both 1 outside MIS): summed over a pixel sample's directions, an unbiased estimate of
+/// ∫ L_i over each direction cell, whichever technique drew it.
+///
+/// Each record goes to the leaf of a point jittered uniformly within the box of the shading point's leaf
+/// (Müller et al. 2017's stochastic spatial box filter, so that neighbouring leaves share what they learn); the
+/// jitter is a hash of the point and the direction, so it depends on nothing but the sample.
 struct Learner<'a> {
-    leaf: u32,
+    stree: &'a STree,
+    p: Vec3,
+    /// The size of the box of the leaf holding p.
+    extent: Vec3,
+    /// Directions per pixel sample of each technique (n_0, n_1).
+    samples: [u32; 2],
     out: &'a mut Vec<GuideRecord>,
 }
 
@@ -443,8 +457,24 @@ impl SampleSink for Learner<'_> {
     #[inline]
     fn record(&mut self, r: SampleRecord) {
         if r.traced() && r.pdf > 0.0 {
-            let value = r.mis_weight * luminance(r.radiance) / r.pdf;
-            self.out.push(GuideRecord { leaf: self.leaf, square: dir_to_square(r.wi), value });
+            let n = self.samples[(r.technique as usize).min(1)].max(1) as f32;
+            let value = r.mis_weight * luminance(r.radiance) / (n * r.pdf);
+            let bits = [self.p.to_array(), r.wi.to_array()]
+                .as_flattened()
+                .iter()
+                .fold(0u64, |h, v| mix64(h ^ v.to_bits() as u64));
+            let u = Vec3::new(
+                (bits & 0x1f_ffff) as f32,
+                ((bits >> 21) & 0x1f_ffff) as f32,
+                ((bits >> 42) & 0x1f_ffff) as f32,
+            ) / (1u32 << 21) as f32;
+            let leaf = self.stree.leaf(self.p + (u - 0.5) * self.extent);
+            let mixture = (r.parts != [0.0; 3]).then(|| MixtureSample {
+                contribution: luminance(r.contribution),
+                pdf: r.pdf,
+                parts: r.parts,
+            });
+            self.out.push(GuideRecord { leaf, square: dir_to_square(r.wi), value, mixture });
         }
     }
 }

@@ -67,6 +67,9 @@ pub struct SampleRecord {
     /// too where no ray was traced, see `outcome`).
     pub radiance: Vec3,
     pub outcome: Outcome,
+    /// For a one-sample mixture over a learned guide (`guided`): the densities of its guide, light and BRDF
+    /// parts at ω_k, of which `pdf` is the weighted sum. Zero for every other strategy.
+    pub parts: [f32; 3],
 }
 
 impl SampleRecord {
@@ -74,7 +77,8 @@ impl SampleRecord {
     #[inline(always)]
     pub fn none(technique: u8) -> Self {
         let (wi, contribution, radiance) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-        Self { technique, wi, pdf: 0.0, mis_weight: 0.0, contribution, radiance, outcome: Outcome::NoSample }
+        let (pdf, outcome, parts) = (0.0, Outcome::NoSample, [0.0; 3]);
+        Self { technique, wi, pdf, mis_weight: 0.0, contribution, radiance, outcome, parts }
     }
 
     /// Whether L_i was found along ω_k (a ray was traced): what a learning strategy can learn from.

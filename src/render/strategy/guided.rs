@@ -1,38 +1,44 @@
 //! Guided sampling (path guiding for direct light; Müller, Gross & Novák 2017): a one-sample mixture of the
 //! learned guide, emitter sampling and BRDF sampling,
 //!
-//! `p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω)`,  (c_g, c_l, c_b) = (½, ¼, ¼),
+//! `p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω)`,
 //!
 //! where p_guide is the quadtree density of the spatial leaf holding the shading point ([`crate::guiding`]),
-//! which the renderer learns from the directions evaluated at the points the camera sees. Where the leaf has
-//! learned nothing (and before any guide exists) c_g = 0 and the others share its weight; where the scene has
-//! no emitters c_l = 0. Since c_l + c_b > 0 wherever f_r L_i (ω·n) > 0 can be, the estimator
+//! which the renderer learns from the directions evaluated at the points the camera sees, and (c_g, c_l, c_b)
+//! are that leaf's weights: (½, ¼, ¼) until learned, then the candidate of least estimated variance
+//! ([`crate::guiding::Moments`]). Where the leaf's quadtree is empty (and before any guide exists) c_g = 0 and
+//! the others share its weight; where the scene has no emitters c_l = 0. Every weight vector has c_l + c_b > 0,
+//! and light or BRDF sampling reaches every direction where f_r L_i (ω·n) > 0, so the estimator
 //! `f_r L_i (ω·n) / p(ω)` stays unbiased whatever the guide learned. The guide learns light only (`L_e V`), not
 //! the BRDF: a change of camera or material keeps it.
 
 use super::brdf::Brdf;
 use super::emitter::Emitter;
 use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Target, Technique};
+use crate::guiding::DEFAULT_WEIGHTS;
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::render::estimator::{integrand, reached};
 use crate::render::sink::{Outcome, SampleRecord, SampleSink};
 use glam::Vec3;
 
-/// The mixture's weights where the guide has a density: guide, light, BRDF.
-pub const WEIGHTS: [f32; 3] = [0.5, 0.25, 0.25];
-
 pub struct Guided;
 
-/// The weights (c_g, c_l, c_b) at a shading point: [`WEIGHTS`] with the parts that cannot sample there left out
-/// and the rest scaled to sum to one.
+/// The weights (c_g, c_l, c_b) at a shading point: its spatial leaf's, with the parts that cannot sample there
+/// left out (no quadtree density, no emitters) and the rest scaled to sum to one; BRDF sampling alone where
+/// nothing is left.
 #[inline]
 pub fn weights(ctx: &SampleContext, sp: &ShadingPoint) -> [f32; 3] {
-    let guide = ctx.guide.is_some_and(|g| g.dtree(sp.p).is_usable());
-    let [g, l, b] = WEIGHTS;
-    let w = [if guide { g } else { 0.0 }, if ctx.emitters.is_some() { l } else { 0.0 }, b];
+    let (usable, [g, l, b]) = match ctx.guide {
+        Some(guide) => {
+            let (dtree, w) = guide.leaf(sp.p);
+            (dtree.is_usable(), w)
+        }
+        None => (false, DEFAULT_WEIGHTS),
+    };
+    let w = [if usable { g } else { 0.0 }, if ctx.emitters.is_some() { l } else { 0.0 }, b];
     let sum = w[0] + w[1] + w[2];
-    w.map(|c| c / sum)
+    if sum > 0.0 { w.map(|c| c / sum) } else { [0.0, 0.0, 1.0] }
 }
 
 /// Which part draws, from one uniform.
@@ -54,9 +60,8 @@ impl Guided {
         let w = weights(ctx, sp);
         let s = match choose(&w, rng.uniform()) {
             0 => {
-                let dtree = ctx.guide?.dtree(sp.p);
-                let wi = dtree.sample(rng)?;
-                DirectionSample { wi, pdf: dtree.pdf(wi), target: Target::Trace }
+                let (wi, pdf) = ctx.guide?.dtree(sp.p).sample(rng)?;
+                DirectionSample { wi, pdf, target: Target::Trace }
             }
             1 => Technique::sample(&Emitter, ctx, sp, rng)?,
             _ => Technique::sample(&Brdf, ctx, sp, rng)?,
@@ -64,15 +69,20 @@ impl Guided {
         Some((s, w))
     }
 
+    /// The densities of the guide, light and BRDF parts at `wi` (the guide's where a guide exists, whatever its
+    /// weight: the weights learn from it).
+    #[inline]
+    fn parts(ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> [f32; 3] {
+        let guide = ctx.guide.map_or(0.0, |g| g.dtree(sp.p).pdf(wi));
+        let light = if ctx.emitters.is_some() { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
+        [guide, light, Technique::pdf(&Brdf, ctx, sp, wi, via)]
+    }
+
     /// The mixture's density with the weights `w` at `sp`.
     #[inline]
     fn mixture_pdf(ctx: &SampleContext, sp: &ShadingPoint, w: &[f32; 3], wi: Vec3, via: Option<Reached>) -> f32 {
-        let guide = match ctx.guide {
-            Some(g) if w[0] > 0.0 => g.dtree(sp.p).pdf(wi),
-            _ => 0.0,
-        };
-        let light = if w[1] > 0.0 { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
-        w[0] * guide + w[1] * light + w[2] * Technique::pdf(&Brdf, ctx, sp, wi, via)
+        let p = Self::parts(ctx, sp, wi, via);
+        w[0] * p[0] + w[1] * p[1] + w[2] * p[2]
     }
 }
 
@@ -114,11 +124,12 @@ impl DirectionStrategy for Guided {
             sink.record(SampleRecord::none(0));
             return Vec3::ZERO;
         };
-        let (contribution, pdf, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+        let (contribution, parts, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
             Ok((value, via)) => {
-                let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, Some(via));
+                let parts = Self::parts(ctx, sp, s.wi, Some(via));
+                let pdf = w[0] * parts[0] + w[1] * parts[1] + w[2] * parts[2];
                 let radiance = ctx.scene.emitted(via.triangle, -s.wi);
-                (value / pdf, pdf, radiance, Outcome::Contributed)
+                (value / pdf, parts, radiance, Outcome::Contributed)
             }
             Err(outcome) => {
                 // An occluded or missed direction still tells the guide something: L_i = 0 there.
@@ -126,11 +137,12 @@ impl DirectionStrategy for Guided {
                     Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
                     Target::Trace => None,
                 };
-                let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, via);
-                (Vec3::ZERO, pdf, Vec3::ZERO, outcome)
+                (Vec3::ZERO, Self::parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome)
             }
         };
-        sink.record(SampleRecord { technique: 0, wi: s.wi, pdf, mis_weight: 1.0, contribution, radiance, outcome });
+        let pdf = w[0] * parts[0] + w[1] * parts[1] + w[2] * parts[2];
+        let wi = s.wi;
+        sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts });
         contribution
     }
 }

@@ -204,7 +204,8 @@ fn directions<S: SampleSink>(
         };
         total += contribution;
         let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
-        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, radiance, outcome });
+        let parts = [0.0; 3];
+        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, radiance, outcome, parts });
     }
     total
 }

@@ -1,6 +1,6 @@
 //! One image being refined: its settings, its film and what it took.
 
-use crate::guiding::Guide;
+use crate::guiding::{Guide, GuideSettings};
 use crate::render::{Film, PassStats, PixelCones, RenderSettings, Renderer};
 use crate::scene::{Camera, Scene};
 use std::sync::Arc;
@@ -21,9 +21,10 @@ pub(super) struct Lane {
     /// The renderer of its passes, kept while the scene and the settings are the same (it owns the state built
     /// per scene and settings).
     renderer: Option<Renderer>,
-    /// The guide the last renderer that learned one finished learning: a new renderer samples from it if it is
-    /// of the same light (camera, material and setting changes keep it).
-    pub(super) guide: Option<Arc<Guide>>,
+    /// The guide the last renderer that learned one finished learning, with the guide settings it learned
+    /// with: a new renderer with those settings samples from it if it is of the same light (camera, material and
+    /// other setting changes keep it).
+    pub(super) guide: Option<(GuideSettings, Arc<Guide>)>,
 }
 
 impl Lane {
@@ -50,8 +51,8 @@ impl Lane {
             Some(r) if Arc::ptr_eq(r.scene(), scene) && *r.settings() == settings => r,
             _ => {
                 let mut renderer = Renderer::new(scene.clone(), settings);
-                if let Some(guide) = &self.guide {
-                    renderer = renderer.with_guide(guide.clone());
+                if let Some(guide) = self.kept_guide() {
+                    renderer = renderer.with_guide(guide);
                 }
                 match cones {
                     Some(cones) => renderer.with_cones(cones.clone()),
@@ -63,9 +64,14 @@ impl Lane {
 
     pub(super) fn keep(&mut self, renderer: Renderer) {
         if let Some(t) = renderer.training().filter(|t| t.is_frozen()) {
-            self.guide = Some(t.guide().clone());
+            self.guide = Some((*t.settings(), t.guide().clone()));
         }
         self.renderer = Some(renderer);
+    }
+
+    /// The kept guide, if it was learned with this lane's guide settings.
+    pub(super) fn kept_guide(&self) -> Option<Arc<Guide>> {
+        self.guide.as_ref().filter(|(s, _)| *s == self.settings.guiding).map(|(_, g)| g.clone())
     }
 
     /// Forgets the learned guide and the renderer that holds it.
@@ -79,6 +85,11 @@ impl Lane {
             self.film.clear();
         } else {
             self.film = Film::new(camera.width, camera.height);
+        }
+        // A guide still learning is learned again from the first sample: the image is then what a fresh render
+        // gives (a finished one is kept, see `guide`).
+        if self.renderer.as_ref().and_then(Renderer::training).is_some_and(|t| !t.is_frozen()) {
+            self.renderer = None;
         }
         self.spp = 0;
         self.passes = 0;

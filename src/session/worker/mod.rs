@@ -420,8 +420,8 @@ impl State {
         let current = &self.shared.resets[i];
         let cancelled = move || current.load(Ordering::Relaxed) != generation;
         let mut renderer = Renderer::with_camera(self.scene.clone(), lane.settings, &small);
-        if let Some(guide) = &lane.guide {
-            renderer = renderer.with_guide(guide.clone());
+        if let Some(guide) = lane.kept_guide() {
+            renderer = renderer.with_guide(guide);
         }
         let mut film = Film::new(small.width, small.height);
         let stats = pool.install(|| renderer.render_pass(&mut film, 0, 1, &cancelled));
