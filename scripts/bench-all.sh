@@ -9,6 +9,8 @@ cargo build --release
 for scene in cornell-box near-light veach-mis default; do
     target/release/illumlab bench "$scene" --out "docs/bench/$scene" "$@"
 done
+# Light through a small hole: MIS resolves it slowly, so the reference is guided's (trained within its samples).
+target/release/illumlab bench occluded-light --reference-strategy guided --out docs/bench/occluded-light "$@"
 # The references are large and reproducible: keep them out of the repository.
 rm -f docs/bench/*/reference.exr docs/bench/*/reference.var.exr
 # Every scene's table at the largest budget, with intervals and verdicts (for the README and docs).

@@ -6,7 +6,7 @@ import csv
 import pathlib
 import re
 
-SCENES = ["cornell-box", "near-light", "veach-mis", "default"]
+SCENES = ["cornell-box", "near-light", "veach-mis", "occluded-light", "default"]
 root = pathlib.Path(__file__).resolve().parent.parent / "docs" / "bench"
 
 

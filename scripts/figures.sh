@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 cargo build --release --quiet
 bin=target/release/illumlab
 spp=${SPP:-16}
-for scene in cornell-box veach-mis near-light default; do
+for scene in cornell-box veach-mis near-light occluded-light default; do
   for strategy in $($bin strategies | awk '{print $1}'); do
     exposure=0
     [ "$scene" = cornell-box ] && exposure=1

@@ -26,6 +26,7 @@ shoot veach-mis brdf 0
 shoot veach-mis emitter 0
 shoot veach-mis mis 0
 shoot near-light emitter -2
+shoot occluded-light guided 1
 shoot_compare() { # name warm-up-seconds seconds scene args…
   # The first run renders the reference into the cache, so the second records convergence from 1 spp.
   local out="screenshots/viewer-compare-$1.png" warm=$2 wait=$3 scene=$4; shift 4
@@ -43,6 +44,8 @@ shoot_compare errors 1 15 cornell-box --strategy emitter --compare cosine --view
 # Fixed primary hits: the standard error is the estimators' own, and solid-angle sampling's is lower under the
 # light than emitter sampling's (1/r²).
 shoot_compare fixed-hits 50 20 near-light --strategy emitter --compare solid-angle --footprint centre --view std-error --target-spp 256 --reference-spp 256 --plot --exposure -2
+# Light through a hole: MIS against guided at equal time, guided training as it refines.
+shoot_compare occluded-light 1 40 occluded-light --strategy mis --compare guided --budget equal-time --view std-error --footprint centre --target-spp 1024 --exposure 1
 shoot_compare plot 50 30 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2
 shoot_probe() { # name seconds scene args…
   local out="screenshots/viewer-probe-$1.png" wait=$2 scene=$3; shift 3
@@ -57,6 +60,8 @@ shoot_probe cornell-box-mis 10 cornell-box --strategy mis --exposure 1 --probe 6
 shoot_probe veach-mis-mis 10 veach-mis --strategy mis --probe 90,200
 shoot_probe veach-mis-emitter 10 veach-mis --strategy emitter --probe 90,200
 shoot_probe compare-default 12 default --strategy mis --compare brdf --probe 150,260
+# The guide learned under the hole: its density (fourth disk) on the opening the integrand shows.
+shoot_probe occluded-light-guided 25 occluded-light --strategy guided --exposure 1 --probe 128,170
 # The near light over a glossy floor (α = 30), the lobe inside the light: brdf-polygon's density follows the lobe,
 # projected-solid-angle's only the cosine.
 glossy=$runtime/glossy-near-light.toml

@@ -14,7 +14,7 @@ total=0
 bad=0
 echo "| scene | strategy | samples | non-finite | seconds |"
 echo "|---|---|---:|---:|---:|"
-for scene in default cornell-box veach-mis near-light; do
+for scene in default cornell-box veach-mis near-light occluded-light; do
   for strategy in $($bin strategies | awk '{print $1}'); do
     line=$($bin render "$scene" --strategy "$strategy" --spp "$spp" --size "$size" --seed 7 -o "$out/x.exr" 2>&1 | tail -1)
     # "512 spp, 4.2 s, 8.0 M samples/s, …, 0 non-finite samples dropped -> …"

@@ -103,12 +103,15 @@ fn small(name: &str) -> Arc<illumlab::scene::Scene> {
 fn every_strategy_matches_the_quadrature_at_probed_points() {
     let (mut checked, mut skipped) = (0, Vec::new());
     for b in BUNDLED_SCENES {
+        // occluded-light's light shows through a small hole, which the quadrature at this budget resolves too
+        // coarsely to judge by (0.1639 where emitter, MIS and guided agree on 0.1548 ± 0.0005 with 2·10⁶ samples
+        // each; brdf 9% above it at the glossy box): tests/guided.rs checks the strategies there against emitter.
+        if b.name == "occluded-light" {
+            continue;
+        }
         let probe = Probe::new(small(b.name), RenderSettings::default());
         let points = probed_points(&probe);
-        // occluded-light has no point lit with nothing in the way (the light shows through a small hole), and there
-        // the quadrature at this budget is too coarse to judge by (0.1639 where emitter, MIS and guided agree on
-        // 0.1548 ± 0.0005 with 2·10⁶ samples each); tests/guided.rs checks the strategies there against emitter.
-        assert!(points.iter().any(|(k, _)| *k == "lit") || b.name == "occluded-light", "{}: no lit point", b.name);
+        assert!(points.iter().any(|(k, _)| *k == "lit"), "{}: no lit point", b.name);
         for (kind, point) in points {
             let q = probe.quadrature(&point, &ProbeSettings { quadrature_nodes: 2_000_000, ..Default::default() });
             let truth = luminance(q.value) as f64;

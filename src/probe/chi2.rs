@@ -11,6 +11,7 @@
 use super::adaptive::{Refinement, integrate_triangle};
 use super::density::density;
 use crate::math::{Frame, SampleRng};
+use crate::render::strategy::guided;
 use crate::render::strategy::light::faces;
 use crate::render::{Domain, Reached, SampleContext, ShadingPoint, Strategy, Target};
 use glam::{DVec2, DVec3, Vec3};
@@ -48,19 +49,39 @@ const PHI_CELLS: usize = 48;
 /// Each light triangle is cut into 4^k cells.
 const TRIANGLE_DEPTH: u32 = 2;
 
-/// Tests `samples` draws of `strategy` at `sp` (streams of `seed`) against its density.
+/// Tests `samples` draws of `strategy` at `sp` (streams of `seed`) against its density. A mixture (MIS, or
+/// `guided`'s guide, light and BRDF parts) is tested part by part, each binned as its own kind is.
 pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, samples: u64, seed: u64) -> ChiSquare {
-    if strategy.domain() == Domain::Mixture {
-        let [n0, n1] = ctx.mis.samples.map(|n| n as u64);
-        let parts: Vec<(ChiSquare, u64)> = ctx
-            .mis
-            .techniques
-            .iter()
-            .zip([n0, n1])
-            .filter(|(_, n)| *n > 0)
-            .enumerate()
-            .map(|(i, (&t, n))| (chi_square(ctx, sp, t, (samples * n / (n0 + n1)).max(1), seed + i as u64), n))
-            .collect();
+    let share = |w: f64| (samples as f64 * w).round().max(1.0) as u64;
+    let parts: Vec<(ChiSquare, f64)> = match strategy.domain() {
+        Domain::Mixture => {
+            let [n0, n1] = ctx.mis.samples.map(|n| n as f64);
+            (ctx.mis.techniques.iter().zip([n0, n1]))
+                .filter(|(_, n)| *n > 0.0)
+                .enumerate()
+                .map(|(i, (&t, n))| {
+                    let w = n / (n0 + n1);
+                    (chi_square(ctx, sp, t, share(w), seed + i as u64), w)
+                })
+                .collect()
+        }
+        Domain::Learned => {
+            let [c_g, c_l, c_b] = guided::weights(ctx, sp).map(|c| c as f64);
+            let mut parts = Vec::new();
+            if c_g > 0.0 {
+                parts.push((chi_square_guide(ctx, sp, share(c_g), seed), c_g));
+            }
+            if c_l > 0.0 {
+                parts.push((chi_square(ctx, sp, Strategy::Emitter, share(c_l), seed + 1), c_l));
+            }
+            if c_b > 0.0 {
+                parts.push((chi_square(ctx, sp, Strategy::Brdf, share(c_b), seed + 2), c_b));
+            }
+            parts
+        }
+        _ => Vec::new(),
+    };
+    if !parts.is_empty() {
         let k = parts.len() as i32;
         let min_p = parts.iter().map(|(c, _)| c.p_value).fold(1.0, f64::min);
         return ChiSquare {
@@ -68,7 +89,7 @@ pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, sa
             statistic: parts.iter().map(|(c, _)| c.statistic).sum(),
             dof: parts.iter().map(|(c, _)| c.dof).sum(),
             p_value: 1.0 - (1.0 - min_p).powi(k),
-            integral: parts.iter().map(|(c, n)| c.integral * *n as f64).sum::<f64>() / (n0 + n1).max(1) as f64,
+            integral: parts.iter().map(|(c, w)| c.integral * w).sum::<f64>(),
             binning: "per technique",
             cells: Vec::new(),
             strategy: Some(strategy),
@@ -81,6 +102,18 @@ pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, sa
     })
 }
 
+/// `guided`'s guide part alone: its quadtree's draws at the point against the quadtree's density, on the sphere.
+fn chi_square_guide(ctx: &SampleContext, sp: &ShadingPoint, samples: u64, seed: u64) -> ChiSquare {
+    let dtree = ctx.guide.map(|g| g.dtree(sp.p));
+    let pdf = |w: Vec3, _: Option<Reached>| dtree.map_or(0.0, |d| d.pdf(w));
+    let frame = Frame::from_z(sp.n);
+    let observed_cell = |k: u64| {
+        let mut rng = SampleRng::new(seed, u64::MAX - 13, k);
+        dtree.and_then(|d| d.sample(&mut rng)).map(|(w, _)| sphere_cell(frame.to_local(w)))
+    };
+    tally(sphere_cells(sp, &pdf), samples, "sphere (guide)", None, observed_cell)
+}
+
 /// [`chi_square`] against another density (to show that a wrong one fails): `pdf(ω, via)`.
 pub fn chi_square_against(
     ctx: &SampleContext,
@@ -90,17 +123,15 @@ pub fn chi_square_against(
     seed: u64,
     pdf: &(dyn Fn(Vec3, Option<Reached>) -> f32 + Sync),
 ) -> ChiSquare {
-    let (binning, mut cells) = match strategy.domain() {
+    let (binning, cells) = match strategy.domain() {
         Domain::Lights => ("light triangles", light_cells(ctx, sp, pdf)),
         _ => ("sphere", sphere_cells(sp, pdf)),
     };
     let frame = Frame::from_z(sp.n);
     let lights: Vec<u32> = ctx.scene.emitters.clone();
-    let failed = cells.len();
-    let mut observed = vec![0.0; cells.len() + 1];
-    for k in 0..samples {
+    let observed_cell = |k: u64| {
         let mut rng = SampleRng::new(seed, u64::MAX - 11, k);
-        let cell = strategy.sample(ctx, sp, &mut rng).and_then(|s| match (strategy.domain(), s.target) {
+        strategy.sample(ctx, sp, &mut rng).and_then(|s| match (strategy.domain(), s.target) {
             (Domain::Lights, Target::Emitter { triangle, point }) => {
                 let slot = lights.iter().position(|&t| t == triangle)?;
                 let tri = &ctx.scene.triangles[triangle as usize];
@@ -108,8 +139,25 @@ pub fn chi_square_against(
             }
             (Domain::Lights, Target::Trace) => None,
             _ => Some(sphere_cell(frame.to_local(s.wi))),
-        });
-        observed[cell.unwrap_or(failed)] += 1.0;
+        })
+    };
+    tally(cells, samples, binning, Some(strategy), observed_cell)
+}
+
+/// Pearson's test of `samples` draws, draw k falling in cell `observed_cell(k)` (`None`: no direction, or one
+/// outside every cell), against the cells' expected probabilities; the rest of the probability is the failure
+/// cell's.
+fn tally(
+    mut cells: Vec<f64>,
+    samples: u64,
+    binning: &'static str,
+    strategy: Option<Strategy>,
+    observed_cell: impl Fn(u64) -> Option<usize>,
+) -> ChiSquare {
+    let failed = cells.len();
+    let mut observed = vec![0.0; cells.len() + 1];
+    for k in 0..samples {
+        observed[observed_cell(k).unwrap_or(failed)] += 1.0;
     }
     let integral: f64 = cells.iter().sum();
     cells.push((1.0 - integral).max(0.0));
@@ -124,15 +172,15 @@ pub fn chi_square_against(
         integral,
         binning,
         cells,
-        strategy: Some(strategy),
+        strategy,
         parts: Vec::new(),
     }
 }
 
-/// The cell a direction falls in, for a test binned as `strategy`'s are: a sphere cell, or the cell of the first
-/// facing emitter triangle it passes through (`None` if it meets none).
-fn cell_of(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, wi: Vec3) -> Option<usize> {
-    if strategy.domain() != Domain::Lights {
+/// The cell a direction falls in, for a test binned on the sphere or (`lights`) on the light triangles: the cell
+/// of the first facing emitter triangle it passes through (`None` if it meets none).
+fn cell_of(ctx: &SampleContext, sp: &ShadingPoint, lights: bool, wi: Vec3) -> Option<usize> {
+    if !lights {
         return Some(sphere_cell(Frame::from_z(sp.n).to_local(wi)));
     }
     let scene = ctx.scene;
@@ -159,14 +207,15 @@ impl ChiSquare {
             let rows: Vec<Picture> = self.parts.iter().map(|p| p.picture(ctx, sp, size)).collect();
             return Picture::stack(&rows, 8);
         }
-        let Some(strategy) = self.strategy else { return Picture::blank(size, size) };
+        // Binned on light triangles, or (guided's guide part too) on the sphere.
+        let lights = self.strategy.is_some_and(|s| s.domain() == Domain::Lights);
         let frame = Frame::from_z(sp.n);
         let top = self.cells.iter().map(|c| c.0.max(c.1)).fold(1.0, f64::max).log10() as f32;
         // Per pixel on the disk, the cell its direction falls in (if any).
         let cells: Vec<Option<Option<usize>>> = (0..size * size)
             .map(|i| {
                 let d = disk_point(i, size)?;
-                Some(cell_of(ctx, sp, strategy, frame.to_world(crate::math::disk_to_hemisphere(d))))
+                Some(cell_of(ctx, sp, lights, frame.to_world(crate::math::disk_to_hemisphere(d))))
             })
             .collect();
         let gap = 8;
