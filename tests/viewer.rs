@@ -450,3 +450,29 @@ fn fixed_primary_hits_reach_the_integrator_and_the_reference() {
     Renderer::new(scene, settings).render_pass(&mut film, 0, reference.spp, &|| false);
     assert!(film.means() == reference.mean, "the reference is the centre footprint's");
 }
+
+fn guide_status(v: &Viewer) -> Option<illumlab::guiding::TrainingStatus> {
+    v.frame()?.guide.as_ref().map(|(t, _)| *t)
+}
+
+/// `guided` in the viewer: it learns as the viewer refines and says so in the status bar, freezes after its
+/// training spp (six iterations at the default 64), and *Reset guide* starts learning again from the first sample.
+#[test]
+fn guided_learns_as_it_refines_and_reset_guide_starts_again() {
+    let mut h = harness(viewer());
+    h.get_by_label("9 guided").click();
+    h.step();
+    step_until(&mut h, "the guide to learn", |v| guide_status(v).is_some_and(|t| t.learned_spp > 0));
+    step_until(&mut h, "the guide to freeze", |v| guide_status(v).is_some_and(|t| t.frozen));
+    h.step();
+    assert!(h.query_by_label_contains("guide frozen after 6 iterations").is_some(), "the status bar says so");
+    let t = guide_status(h.state()).expect("a guide");
+    assert!(t.leaves > 1 && t.dtree_nodes > 0 && t.bytes > 0 && !t.kept, "{t:?}");
+    let before = h.state().frame().map(|f| f.generation).expect("a frame");
+    h.get_by_label("Reset guide").click();
+    h.step();
+    step_until(&mut h, "learning again", |v| {
+        v.frame().is_some_and(|f| f.generation > before && !f.preview)
+            && guide_status(v).is_some_and(|t| !t.frozen && !t.kept && t.iteration < 6)
+    });
+}

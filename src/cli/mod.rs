@@ -346,18 +346,7 @@ fn render(args: RenderArgs) -> Result<()> {
 /// the render's summary).
 pub(crate) fn print_training(training: &Training) {
     for r in training.log() {
-        eprintln!(
-            "guide iteration {}: learned from {} spp ({} records, {:.1} ms), {} spatial leaves, {} quadtree nodes, \
-             {:.1} KiB, built in {:.1} ms",
-            r.iteration,
-            r.spp,
-            r.records,
-            r.learn.as_secs_f64() * 1e3,
-            r.leaves,
-            r.dtree_nodes,
-            r.bytes as f64 / 1024.0,
-            r.build.as_secs_f64() * 1e3
-        );
+        eprintln!("guide {r}");
     }
     let frozen = if training.is_frozen() { "frozen" } else { "still learning" };
     eprintln!("guide: {frozen} after {} iterations", training.log().len());

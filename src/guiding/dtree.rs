@@ -351,21 +351,21 @@ impl DTree {
         if !(total > 0.0) {
             return shape;
         }
-        // (node of the new shape, node of self or None where self has a leaf, the quadrant's energy per child
-        // share, depth): a quadrant of self that is a leaf spreads its energy evenly over the new children.
-        let mut stack = vec![(0usize, Some(0usize), [0.0; 4], 1usize)];
+        // (node of the new shape, node of self or None where self has a leaf, each quadrant's share of that leaf's
+        // energy, depth): a quadrant of self that is a leaf spreads its energy evenly over the new quadrants.
+        let mut stack = vec![(0usize, Some(0usize), 0.0f64, 1usize)];
         while let Some((new, old, spread, depth)) = stack.pop() {
             for q in 0..4 {
                 let (energy, old_child) = match old {
                     Some(o) => (self.energy[o][q], self.shape.nodes[o].children[q]),
-                    None => (spread[q], 0),
+                    None => (spread, 0),
                 };
                 if depth < max_depth && energy > threshold * total {
                     let child = shape.nodes.len();
                     shape.nodes.push(Node::default());
                     shape.nodes[new].children[q] = child as u32;
                     let next = if old_child != 0 { Some(old_child as usize) } else { None };
-                    stack.push((child, next, [energy / 4.0; 4], depth + 1));
+                    stack.push((child, next, energy / 4.0, depth + 1));
                 }
             }
         }

@@ -137,24 +137,9 @@ pub fn markdown(report: &BenchReport, ctx: &BenchContext) -> String {
         let _ = writeln!(md, "\nTraced directions (shadow and BRDF rays) that found light: {}.", rates.join(", "));
     }
     for (strategy, log) in &report.guides {
-        let _ = writeln!(
-            md,
-            "\n{strategy}'s guide, per training iteration: spp learned from, records, ms to learn them, spatial \
-             leaves, quadtree nodes, KiB, build ms:"
-        );
+        let _ = writeln!(md, "\n{strategy}'s guide (first seed), per training iteration:");
         for r in log {
-            let _ = writeln!(
-                md,
-                "- {}: {} spp, {} records, {:.1} ms, {} leaves, {} nodes, {:.1} KiB, {:.1} ms",
-                r.iteration,
-                r.spp,
-                r.records,
-                r.learn.as_secs_f64() * 1e3,
-                r.leaves,
-                r.dtree_nodes,
-                r.bytes as f64 / 1024.0,
-                r.build.as_secs_f64() * 1e3
-            );
+            let _ = writeln!(md, "- {r}");
         }
     }
     md

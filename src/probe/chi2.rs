@@ -164,17 +164,7 @@ fn tally(
     let (statistic, dof) = pearson(&observed, &cells, samples as f64);
     let p_value = p_value(statistic, dof);
     let cells = observed.into_iter().zip(cells.iter().map(|e| e * samples as f64)).collect();
-    ChiSquare {
-        samples,
-        statistic,
-        dof,
-        p_value,
-        integral,
-        binning,
-        cells,
-        strategy,
-        parts: Vec::new(),
-    }
+    ChiSquare { samples, statistic, dof, p_value, integral, binning, cells, strategy, parts: Vec::new() }
 }
 
 /// The cell a direction falls in, for a test binned on the sphere or (`lights`) on the light triangles: the cell

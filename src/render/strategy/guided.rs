@@ -90,7 +90,8 @@ impl DirectionStrategy for Guided {
     const NAME: &'static str = "guided";
     const DESCRIPTION: &'static str =
         "path guiding: a learned SD-tree of incident light, mixed with emitter and BRDF sampling (Müller 2017)";
-    const PDF: &'static str = "p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω),  c = (½, ¼, ¼)";
+    const PDF: &'static str =
+        "p(ω) = c_g p_guide(ω) + c_l p_light(ω) + c_b p_brdf(ω),  c learned per region, from (½, ¼, ¼)";
     const DOMAIN: Domain = Domain::Learned;
 
     /// A direction of the mixture with the mixture's density (which, for a direction the guide or the BRDF
