@@ -13,6 +13,7 @@
 //! ∫_cell L_i dω, so p(ω) ∝ L_i (piecewise constant) as the records grow. A tree whose energies are all zero has
 //! no density (`pdf` is 0, `sample` gives `None`): the strategy that uses it then takes no guided samples.
 
+use super::shape::{Node, Shape, quadrant};
 use crate::math::SampleRng;
 use glam::{DVec2, Vec2, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -46,95 +47,6 @@ fn square_to_dir_f64(s: DVec2) -> Vec3 {
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
     let (sin_phi, cos_phi) = (std::f64::consts::TAU * s.y).sin_cos();
     glam::DVec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta).as_vec3()
-}
-
-/// Quadrant q of a node's square: bit 0 is the right half (x ≥ ½), bit 1 the upper half (y ≥ ½).
-#[inline]
-fn quadrant(s: DVec2) -> (usize, DVec2) {
-    let (right, up) = (s.x >= 0.5, s.y >= 0.5);
-    let q = right as usize | (up as usize) << 1;
-    let local = DVec2::new(if right { s.x - 0.5 } else { s.x }, if up { s.y - 0.5 } else { s.y }) * 2.0;
-    (q, local.min(DVec2::splat(1.0 - f64::EPSILON)))
-}
-
-/// One node: its four quadrants' children (0: the quadrant is a leaf; the root, index 0, is no one's child).
-#[derive(Clone, Debug, Default, PartialEq)]
-struct Node {
-    children: [u32; 4],
-}
-
-/// The shape of a quadtree, shared by the density that samples and the sums that record.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Shape {
-    nodes: Vec<Node>,
-}
-
-impl Default for Shape {
-    /// The root alone: four quadrants.
-    fn default() -> Self {
-        Self { nodes: vec![Node::default()] }
-    }
-}
-
-impl Shape {
-    /// Every leaf's square: (lower corner, side), depth first.
-    pub fn leaves(&self) -> Vec<(Vec2, f32)> {
-        let mut out = Vec::new();
-        let mut stack = vec![(0usize, Vec2::ZERO, 1.0f32)];
-        while let Some((node, corner, side)) = stack.pop() {
-            let half = side * 0.5;
-            for q in 0..4 {
-                let c = corner + Vec2::new((q & 1) as f32, (q >> 1) as f32) * half;
-                match self.nodes[node].children[q] {
-                    0 => out.push((c, half)),
-                    child => stack.push((child as usize, c, half)),
-                }
-            }
-        }
-        out
-    }
-
-    /// The leaf holding square point `s`: (node, quadrant).
-    #[inline]
-    fn leaf(&self, s: Vec2) -> (usize, usize) {
-        let (mut node, mut s) = (0usize, s.as_dvec2());
-        loop {
-            let (q, local) = quadrant(s);
-            match self.nodes[node].children[q] {
-                0 => return (node, q),
-                child => (node, s) = (child as usize, local),
-            }
-        }
-    }
-
-    pub fn nodes(&self) -> usize {
-        self.nodes.len()
-    }
-
-    /// The side of the leaf holding square point `s`.
-    pub fn leaf_side(&self, s: Vec2) -> f32 {
-        let (mut node, mut s, mut side) = (0usize, s.as_dvec2(), 0.5f32);
-        loop {
-            let (q, local) = quadrant(s);
-            match self.nodes[node].children[q] {
-                0 => return side,
-                child => (node, s, side) = (child as usize, local, side * 0.5),
-            }
-        }
-    }
-
-    pub fn depth(&self) -> usize {
-        fn depth(shape: &Shape, node: usize) -> usize {
-            1 + shape.nodes[node]
-                .children
-                .iter()
-                .filter(|&&c| c != 0)
-                .map(|&c| depth(shape, c as usize))
-                .max()
-                .unwrap_or(0)
-        }
-        depth(self, 0)
-    }
 }
 
 /// Sums of recorded values per leaf of a [`Shape`], in fixed point (order-independent), and how many records.
@@ -368,41 +280,6 @@ impl DTree {
                     stack.push((child, next, energy / 4.0, depth + 1));
                 }
             }
-        }
-        shape
-    }
-}
-
-impl Shape {
-    /// A shape refined uniformly to `depth` levels (4^depth leaves), for tests and synthetic guides.
-    pub fn uniform(depth: usize) -> Self {
-        let mut shape = Shape::default();
-        let mut level = vec![0usize];
-        for _ in 1..depth {
-            let mut next = Vec::new();
-            for &node in &level {
-                for q in 0..4 {
-                    let child = shape.nodes.len();
-                    shape.nodes.push(Node::default());
-                    shape.nodes[node].children[q] = child as u32;
-                    next.push(child);
-                }
-            }
-            level = next;
-        }
-        shape
-    }
-
-    /// A shape refined only along the path to the square point `s`, `depth` levels deep.
-    pub fn towards(s: Vec2, depth: usize) -> Self {
-        let mut shape = Shape::default();
-        let (mut node, mut s) = (0usize, s.as_dvec2());
-        for _ in 1..depth {
-            let (q, local) = quadrant(s);
-            let child = shape.nodes.len();
-            shape.nodes.push(Node::default());
-            shape.nodes[node].children[q] = child as u32;
-            (node, s) = (child, local);
         }
         shape
     }

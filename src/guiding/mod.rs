@@ -17,11 +17,13 @@
 
 mod dtree;
 mod mixture;
+mod shape;
 mod stree;
 mod training;
 
-pub use dtree::{DTree, Shape, Sums, dir_to_square, square_to_dir};
+pub use dtree::{DTree, Sums, dir_to_square, square_to_dir};
 pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
+pub use shape::Shape;
 pub use stree::STree;
 pub use training::{GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
 

@@ -3,11 +3,11 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
-use super::sink::{SampleRecord, SampleSink};
+use super::sink::{Census, Learner};
 use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
-use crate::guiding::{Guide, GuideRecord, GuideSettings, MixtureSample, STree, Training, dir_to_square};
-use crate::math::{PixelStreams, SampleRng, luminance, mix64};
+use crate::guiding::{Guide, GuideRecord, GuideSettings, Training};
+use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
 use glam::Vec3;
@@ -409,73 +409,6 @@ impl Renderer {
             _ => strategy.estimate(&ctx, &sp, rng, rays, &mut ()),
         };
         emitted + estimate
-    }
-}
-
-/// Directions along which L_i was looked for (a ray traced), and those that found light.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Census {
-    pub traced: u64,
-    pub lit: u64,
-}
-
-impl Census {
-    /// The share of traced directions that found light.
-    pub fn success_rate(&self) -> f64 {
-        if self.traced == 0 { 0.0 } else { self.lit as f64 / self.traced as f64 }
-    }
-}
-
-impl SampleSink for Census {
-    fn record(&mut self, r: SampleRecord) {
-        if r.traced() {
-            self.traced += 1;
-            self.lit += (r.radiance != Vec3::ZERO) as u64;
-        }
-    }
-}
-
-/// The sink of a pass that learns: every direction along which L_i was found becomes a guide record of the
-/// shading point's spatial leaf, valued `w L_i / (n_i p_i)` (luminance; w the MIS weight and n_i the directions
-/// of its technique, both 1 outside MIS): summed over a pixel sample's directions, an unbiased estimate of
-/// ∫ L_i over each direction cell, whichever technique drew it.
-///
-/// Each record goes to the leaf of a point jittered uniformly within the box of the shading point's leaf
-/// (Müller et al. 2017's stochastic spatial box filter, so that neighbouring leaves share what they learn); the
-/// jitter is a hash of the point and the direction, so it depends on nothing but the sample.
-struct Learner<'a> {
-    stree: &'a STree,
-    p: Vec3,
-    /// The size of the box of the leaf holding p.
-    extent: Vec3,
-    /// Directions per pixel sample of each technique (n_0, n_1).
-    samples: [u32; 2],
-    out: &'a mut Vec<GuideRecord>,
-}
-
-impl SampleSink for Learner<'_> {
-    #[inline]
-    fn record(&mut self, r: SampleRecord) {
-        if r.traced() && r.pdf > 0.0 {
-            let n = self.samples[(r.technique as usize).min(1)].max(1) as f32;
-            let value = r.mis_weight * luminance(r.radiance) / (n * r.pdf);
-            let bits = [self.p.to_array(), r.wi.to_array()]
-                .as_flattened()
-                .iter()
-                .fold(0u64, |h, v| mix64(h ^ v.to_bits() as u64));
-            let u = Vec3::new(
-                (bits & 0x1f_ffff) as f32,
-                ((bits >> 21) & 0x1f_ffff) as f32,
-                ((bits >> 42) & 0x1f_ffff) as f32,
-            ) / (1u32 << 21) as f32;
-            let leaf = self.stree.leaf(self.p + (u - 0.5) * self.extent);
-            let mixture = (r.parts != [0.0; 3]).then(|| MixtureSample {
-                contribution: luminance(r.contribution),
-                pdf: r.pdf,
-                parts: r.parts,
-            });
-            self.out.push(GuideRecord { leaf, square: dir_to_square(r.wi), value, mixture });
-        }
     }
 }
 
