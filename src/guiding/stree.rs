@@ -42,19 +42,7 @@ impl STree {
     /// The leaf holding `p` (a point outside the cube: the leaf of the nearest point inside).
     #[inline]
     pub fn leaf(&self, p: Vec3) -> u32 {
-        let mut x = ((p - self.origin) / self.side).clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
-        let (mut node, mut axis) = (0usize, 0usize);
-        loop {
-            match self.nodes[node] {
-                SNode::Leaf(leaf) => return leaf,
-                SNode::Inner(children) => {
-                    let upper = x[axis] >= 0.5;
-                    x[axis] = if upper { x[axis] * 2.0 - 1.0 } else { x[axis] * 2.0 };
-                    node = children[upper as usize] as usize;
-                    axis = (axis + 1) % 3;
-                }
-            }
-        }
+        self.leaf_extent(p).0
     }
 
     /// The leaf holding `p` and its box's size.
@@ -161,7 +149,6 @@ mod tests {
             }
         }
         assert_eq!(seen.len(), 8, "each octant its own leaf");
-        // Split only leaf 3 further.
         // Split only leaf 3 further: 300 and 150 are split, 75 is not.
         let mut counts = vec![0; 16];
         counts[3] = 300;

@@ -15,7 +15,7 @@
 use super::brdf::Brdf;
 use super::emitter::Emitter;
 use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Target, Technique};
-use crate::guiding::DEFAULT_WEIGHTS;
+use crate::guiding::{DEFAULT_WEIGHTS, DTree};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::render::estimator::{integrand, reached};
@@ -29,16 +29,47 @@ pub struct Guided;
 /// nothing is left.
 #[inline]
 pub fn weights(ctx: &SampleContext, sp: &ShadingPoint) -> [f32; 3] {
-    let (usable, [g, l, b]) = match ctx.guide {
-        Some(guide) => {
-            let (dtree, w) = guide.leaf(sp.p);
-            (dtree.is_usable(), w)
-        }
-        None => (false, DEFAULT_WEIGHTS),
-    };
-    let w = [if usable { g } else { 0.0 }, if ctx.emitters.is_some() { l } else { 0.0 }, b];
-    let sum = w[0] + w[1] + w[2];
-    if sum > 0.0 { w.map(|c| c / sum) } else { [0.0, 0.0, 1.0] }
+    Mixture::at(ctx, sp).w
+}
+
+/// The mixture at one shading point: its spatial leaf's quadtree (where a guide exists) and its weights, looked up
+/// once per sample.
+struct Mixture<'a> {
+    dtree: Option<&'a DTree>,
+    w: [f32; 3],
+}
+
+impl<'a> Mixture<'a> {
+    #[inline]
+    fn at(ctx: &SampleContext<'a>, sp: &ShadingPoint) -> Self {
+        let (dtree, [g, l, b]) = match ctx.guide {
+            Some(guide) => {
+                let (dtree, w) = guide.leaf(sp.p);
+                (Some(dtree), w)
+            }
+            None => (None, DEFAULT_WEIGHTS),
+        };
+        let usable = dtree.is_some_and(DTree::is_usable);
+        let w = [if usable { g } else { 0.0 }, if ctx.emitters.is_some() { l } else { 0.0 }, b];
+        let sum = w[0] + w[1] + w[2];
+        let w = if sum > 0.0 { w.map(|c| c / sum) } else { [0.0, 0.0, 1.0] };
+        Self { dtree, w }
+    }
+
+    /// The densities of the guide, light and BRDF parts at `wi` (the guide's where a guide exists, whatever its
+    /// weight: the weights learn from it).
+    #[inline]
+    fn parts(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> [f32; 3] {
+        let guide = self.dtree.map_or(0.0, |d| d.pdf(wi));
+        let light = if ctx.emitters.is_some() { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
+        [guide, light, Technique::pdf(&Brdf, ctx, sp, wi, via)]
+    }
+
+    /// The mixture's density, from its parts'.
+    #[inline]
+    fn pdf(&self, parts: &[f32; 3]) -> f32 {
+        self.w[0] * parts[0] + self.w[1] * parts[1] + self.w[2] * parts[2]
+    }
 }
 
 /// Which part draws, from one uniform.
@@ -56,33 +87,21 @@ fn choose(w: &[f32; 3], u: f32) -> usize {
 impl Guided {
     /// A direction from the part chosen, with that part's own density (the estimator divides by the mixture's).
     #[inline]
-    fn sample_part(ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<(DirectionSample, [f32; 3])> {
-        let w = weights(ctx, sp);
-        let s = match choose(&w, rng.uniform()) {
+    fn sample_part<'a>(
+        ctx: &SampleContext<'a>,
+        sp: &ShadingPoint,
+        rng: &mut SampleRng,
+    ) -> Option<(DirectionSample, Mixture<'a>)> {
+        let m = Mixture::at(ctx, sp);
+        let s = match choose(&m.w, rng.uniform()) {
             0 => {
-                let (wi, pdf) = ctx.guide?.dtree(sp.p).sample(rng)?;
+                let (wi, pdf) = m.dtree?.sample(rng)?;
                 DirectionSample { wi, pdf, target: Target::Trace }
             }
             1 => Technique::sample(&Emitter, ctx, sp, rng)?,
             _ => Technique::sample(&Brdf, ctx, sp, rng)?,
         };
-        Some((s, w))
-    }
-
-    /// The densities of the guide, light and BRDF parts at `wi` (the guide's where a guide exists, whatever its
-    /// weight: the weights learn from it).
-    #[inline]
-    fn parts(ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> [f32; 3] {
-        let guide = ctx.guide.map_or(0.0, |g| g.dtree(sp.p).pdf(wi));
-        let light = if ctx.emitters.is_some() { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
-        [guide, light, Technique::pdf(&Brdf, ctx, sp, wi, via)]
-    }
-
-    /// The mixture's density with the weights `w` at `sp`.
-    #[inline]
-    fn mixture_pdf(ctx: &SampleContext, sp: &ShadingPoint, w: &[f32; 3], wi: Vec3, via: Option<Reached>) -> f32 {
-        let p = Self::parts(ctx, sp, wi, via);
-        w[0] * p[0] + w[1] * p[1] + w[2] * p[2]
+        Some((s, m))
     }
 }
 
@@ -97,17 +116,18 @@ impl DirectionStrategy for Guided {
     /// A direction of the mixture with the mixture's density (which, for a direction the guide or the BRDF
     /// drew, needs the emitter triangle it reaches: one more ray).
     fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        let (s, w) = Self::sample_part(ctx, sp, rng)?;
+        let (s, m) = Self::sample_part(ctx, sp, rng)?;
         let via = match s.target {
             Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
             Target::Trace => reached(ctx.scene, sp, s.wi),
         };
-        let pdf = Self::mixture_pdf(ctx, sp, &w, s.wi, via);
+        let pdf = m.pdf(&m.parts(ctx, sp, s.wi, via));
         (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { pdf, ..s })
     }
 
     fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
-        Self::mixture_pdf(ctx, sp, &weights(ctx, sp), wi, via)
+        let m = Mixture::at(ctx, sp);
+        m.pdf(&m.parts(ctx, sp, wi, via))
     }
 
     /// `f_r L_i (ω·n) / p(ω)` with the mixture's density, found after L_i (the ray the estimator traces anyway
@@ -121,16 +141,15 @@ impl DirectionStrategy for Guided {
         rays: &mut u64,
         sink: &mut S,
     ) -> Vec3 {
-        let Some((s, w)) = Self::sample_part(ctx, sp, rng) else {
+        let Some((s, m)) = Self::sample_part(ctx, sp, rng) else {
             sink.record(SampleRecord::none(0));
             return Vec3::ZERO;
         };
         let (contribution, parts, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
             Ok((value, via)) => {
-                let parts = Self::parts(ctx, sp, s.wi, Some(via));
-                let pdf = w[0] * parts[0] + w[1] * parts[1] + w[2] * parts[2];
+                let parts = m.parts(ctx, sp, s.wi, Some(via));
                 let radiance = ctx.scene.emitted(via.triangle, -s.wi);
-                (value / pdf, parts, radiance, Outcome::Contributed)
+                (value / m.pdf(&parts), parts, radiance, Outcome::Contributed)
             }
             Err(outcome) => {
                 // An occluded or missed direction still tells the guide something: L_i = 0 there.
@@ -138,11 +157,10 @@ impl DirectionStrategy for Guided {
                     Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
                     Target::Trace => None,
                 };
-                (Vec3::ZERO, Self::parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome)
+                (Vec3::ZERO, m.parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome)
             }
         };
-        let pdf = w[0] * parts[0] + w[1] * parts[1] + w[2] * parts[2];
-        let wi = s.wi;
+        let (wi, pdf) = (s.wi, m.pdf(&parts));
         sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts });
         contribution
     }
