@@ -11,8 +11,8 @@
 //! Layers, bottom up: [`math`] and [`sampling`] are pure and tested against closed forms; [`scene`] loads
 //! triangles, Phong materials, emissive triangles and a camera and builds the BVH; [`render`] runs the estimators
 //! over an image; [`measure`] judges estimates against a reference; [`session`] refines one image or two
-//! (compare mode) and a reference in the background. Only [`app`], the egui/eframe
-//! viewer on top, knows about the UI.
+//! (compare mode) and a reference in the background, headless; a [`tour`] step sets a session. Only [`app`], the
+//! egui/eframe viewer on top, knows about the UI.
 //!
 //! Conventions: `wo` points towards the viewer, `wi` towards the light; local frames have z = n; uniforms are
 //! named `u` and live in [0, 1); a density names its measure (`pdf_area`, `pdf_solid_angle`).
@@ -27,3 +27,4 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod session;
+pub mod tour;

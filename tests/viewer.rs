@@ -306,8 +306,14 @@ fn compare_mode_swap_wipe_budgets_and_export() {
     h.step();
     assert_eq!(h.state().budget(), illumlab::session::worker::Budget::EqualSamples);
 
+    // Both lanes past the restart of the budget change (their generations agree), each with a recorded run.
     step_until(&mut h, "the reference and a recorded run", |v| {
-        v.reference().is_some() && v.history().iter().any(|s| s.points.len() >= 2)
+        let (Some(a), Some(b)) = (v.frame(), v.frame_b()) else { return false };
+        a.generation == b.generation
+            && a.spp >= 2
+            && b.spp >= 2
+            && v.reference().is_some()
+            && v.history().iter().any(|s| s.points.len() >= 2)
     });
     // The convergence window: its plots, the efficiency table and the winner (kittest also fails on any glyph the
     // fonts cannot draw).
@@ -475,4 +481,118 @@ fn guided_learns_as_it_refines_and_reset_guide_starts_again() {
         v.frame().is_some_and(|f| f.generation > before && !f.preview)
             && guide_status(v).is_some_and(|t| !t.frozen && !t.kept && t.iteration < 6)
     });
+}
+
+/// Presenting the lecture: Page Down goes to the next step (its strategy, view and caption on screen), Page Up
+/// returns; the presenter view hides the side panel; Ctrl + scales the UI and is remembered, not an exposure change.
+#[test]
+fn a_tour_steps_with_page_down_and_page_up() {
+    let mut v = viewer();
+    let dir = tempfile::tempdir().unwrap();
+    let scale_file = dir.path().join("ui-scale");
+    v.set_ui_scale_file(scale_file.clone());
+    v.present(illumlab::tour::Tour::lecture());
+    let mut h = harness(v);
+    let lecture = illumlab::tour::Tour::lecture();
+    let check = |h: &mut Harness<'_, Viewer>, i: usize| {
+        let step = &lecture.steps[i];
+        h.step();
+        assert_eq!(h.state().presenter().map(|p| p.index()), Some(i));
+        assert!(h.query_by_label(&step.caption.title).is_some(), "the title of step {} is on screen", i + 1);
+        assert!(h.query_by_label(&step.caption.text).is_some(), "the caption of step {} is on screen", i + 1);
+        let s = h.state().session();
+        if let Some(strategy) = step.strategy {
+            assert_eq!(s.settings().strategy, strategy);
+        }
+        if let Some(view) = step.view {
+            assert_eq!(s.view(), view);
+        }
+        if let Some(compare) = step.compare {
+            assert_eq!(s.is_comparing(), compare.is_some());
+        }
+    };
+    check(&mut h, 0);
+    assert!(h.state().is_presenting() && h.query_by_label("Strategy").is_none(), "the presenter view hides the panels");
+    step_until(&mut h, "the first step's image", |v| v.frame().is_some_and(|f| !f.preview));
+    h.key_press(egui::Key::PageDown);
+    check(&mut h, 1);
+    h.key_press(egui::Key::PageDown);
+    check(&mut h, 2);
+    assert_eq!(h.state().session().view(), View::RelativeVariance);
+    h.key_press(egui::Key::PageUp);
+    check(&mut h, 1);
+    assert_eq!(h.state().session().view(), View::Image, "Page Up returns to the step's view");
+    h.key_press(egui::Key::ArrowRight);
+    check(&mut h, 2);
+    h.key_press(egui::Key::ArrowLeft);
+    check(&mut h, 1);
+    step_until(&mut h, "the step's images", |v| v.frame().is_some_and(|f| f.settings.strategy == Strategy::Cosine));
+    // Every step, forwards (its caption drawn: every glyph of the formulas exists in egui's fonts), then back.
+    h.key_press(egui::Key::Home);
+    check(&mut h, 0);
+    for i in 1..lecture.steps.len() {
+        h.key_press(egui::Key::PageDown);
+        check(&mut h, i);
+    }
+    for i in (0..lecture.steps.len() - 1).rev() {
+        h.key_press(egui::Key::PageUp);
+        check(&mut h, i);
+    }
+
+    // T leaves the presenter view: the panels are back, with the tour's step list.
+    h.key_press(egui::Key::T);
+    h.step();
+    assert!(h.query_by_label("Strategy").is_some() && h.query_by_label("presenter view (T)").is_some());
+
+    // Ctrl + zooms the UI (egui's own shortcut), is remembered in the file, and leaves the exposure alone.
+    let exposure = h.state().session().exposure();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Plus);
+    h.step();
+    h.step();
+    assert!(h.ctx.zoom_factor() > 1.0, "zoomed: {}", h.ctx.zoom_factor());
+    assert_eq!(h.state().session().exposure(), exposure);
+    let saved: f32 = std::fs::read_to_string(&scale_file).expect("remembered").trim().parse().unwrap();
+    assert_eq!(saved, h.ctx.zoom_factor());
+}
+
+/// An invalid tour file opened from the side panel is one error on screen naming the step and the field; the
+/// viewer keeps rendering. "Save this view as a step" writes a tour that "Present" then presents.
+#[test]
+fn an_invalid_tour_is_an_error_on_screen_and_a_saved_view_presents() {
+    let dir = tempfile::tempdir().unwrap();
+    let present = |h: &mut Harness<'_, Viewer>, path: &std::path::Path, button: &str| {
+        h.get_by_label("tour file").focus();
+        h.step();
+        h.get_by_label("tour file").type_text(&path.to_string_lossy());
+        h.step();
+        h.get_by_label(button).click();
+        h.step();
+    };
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[[step]]\ntitle = \"First\"\nview = \"noise\"\n").unwrap();
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    present(&mut h, &bad, "Present");
+    let error = h.state().error().expect("an error on screen").to_string();
+    assert!(error.contains("step 1 (\"First\"), field `view`") && error.contains("noise"), "{error}");
+    assert!(h.state().presenter().is_none());
+    let g = h.state().frame().unwrap().generation;
+    h.key_press(egui::Key::R);
+    step_until(&mut h, "rendering to go on", |v| v.frame().is_some_and(|f| f.generation > g));
+
+    let mut h = harness(viewer());
+    step_until(&mut h, "a frame", |v| v.frame().is_some());
+    h.get_by_label("3 brdf").click();
+    h.step();
+    let saved = dir.path().join("saved.toml");
+    present(&mut h, &saved, "Save this view as a step");
+    let tour = illumlab::tour::Tour::load(saved.to_str().unwrap()).expect("the saved tour loads");
+    assert_eq!(tour.steps.len(), 1);
+    assert_eq!(tour.steps[0].strategy, Some(Strategy::Brdf));
+    h.get_by_label("1 uniform").click();
+    h.step();
+    h.get_by_label("Present").click();
+    h.step();
+    assert_eq!(h.state().presenter().map(|p| p.tour.steps.len()), Some(1));
+    assert_eq!(h.state().session().settings().strategy, Strategy::Brdf, "the saved step's strategy is back");
 }

@@ -1,82 +1,79 @@
 //! The side panel's comparison section: compare mode with B's strategy, swap, budget, layout and wipe; the view
 //! (image or error map); the reference (status, spp, compute, load an EXR); export.
 
-use super::viewer::Viewer;
+use super::viewer::UiState;
 use crate::render::{Footprint, Strategy};
+use crate::session::Session;
 use crate::session::views::View;
 use crate::session::worker::{Budget, ReferenceStatus};
 use std::path::PathBuf;
 
-pub fn compare_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+pub fn compare_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
     ui.heading("Compare");
-    let mut on = v.comparing;
+    let mut on = s.is_comparing();
     if ui.checkbox(&mut on, "Compare A | B (C)").changed() {
-        v.set_comparing(on);
+        s.set_comparing(on);
     }
-    if v.comparing {
+    if s.is_comparing() {
         ui.horizontal(|ui| {
-            ui.label(format!("A: {}", v.settings.strategy.name()));
-            let mut b = v.settings_b.strategy;
+            ui.label(format!("A: {}", s.settings().strategy.name()));
+            let mut b = s.settings_b().strategy;
             egui::ComboBox::from_label("B strategy").selected_text(b.name()).show_ui(ui, |ui| {
-                for s in Strategy::ALL {
-                    ui.selectable_value(&mut b, s, s.name());
+                for strategy in Strategy::ALL {
+                    ui.selectable_value(&mut b, strategy, strategy.name());
                 }
             });
-            v.set_strategy_b(b);
+            s.set_strategy_b(b);
         });
         if ui.button("Swap A/B (X)").clicked() {
-            v.swap_lanes();
+            s.swap_lanes();
         }
         ui.horizontal(|ui| {
             for budget in [Budget::EqualSamples, Budget::EqualTime] {
-                if ui.radio(v.budget == budget, budget.name()).clicked() {
-                    v.set_budget(budget);
+                if ui.radio(s.budget() == budget, budget.name()).clicked() {
+                    s.set_budget(budget);
                 }
             }
         });
-        ui.small(match v.budget {
+        ui.small(match s.budget() {
             Budget::EqualSamples => "both reach the same spp",
             Budget::EqualTime => "both get the same CPU time; each shows its own spp",
         });
-        ui.checkbox(&mut v.side_by_side, "side by side");
-        let mut wipe = v.wipe;
-        if ui.add_enabled(!v.side_by_side, egui::Slider::new(&mut wipe, 0.0..=1.0).text("wipe")).changed() {
-            v.set_wipe(wipe);
-        }
+        ui.checkbox(&mut u.side_by_side, "side by side");
+        let side_by_side = u.side_by_side;
+        ui.add_enabled(!side_by_side, egui::Slider::new(&mut u.wipe, 0.0..=1.0).text("wipe"));
         ui.small("Same seed, same random streams per pixel: the difference you see is the estimator.");
     }
     ui.separator();
-    view_ui(v, ui);
-    footprint_ui(v, ui);
+    view_ui(s, ui);
+    footprint_ui(s, ui);
     ui.separator();
-    reference_ui(v, ui);
-    if v.comparing {
+    reference_ui(s, u, ui);
+    if s.is_comparing() {
         ui.separator();
         if ui.button("Export comparison").clicked() {
-            v.export_comparison();
+            super::compare_mode::export_comparison(s, u);
         }
     }
     if ui.button("Convergence plot (P)").clicked() {
-        if v.show_plot {
-            v.show_plot = false;
-        } else {
-            v.show_convergence_plot();
-        }
+        super::convergence::toggle_plot(s, u);
     }
 }
 
-fn view_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+fn view_ui(s: &mut Session, ui: &mut egui::Ui) {
     ui.heading("View");
-    let mut view = v.view;
+    let mut view = s.view();
     egui::ComboBox::from_label("show").selected_text(view.name()).show_ui(ui, |ui| {
         for option in View::ALL {
-            if option.needs_comparison() && !v.comparing {
+            if option.needs_comparison() && !s.is_comparing() {
                 continue;
             }
             ui.selectable_value(&mut view, option, option.name());
         }
     });
-    v.set_view(view);
+    if view != s.view() {
+        s.set_view(view);
+    }
     if view != View::Image {
         ui.small(view.description());
     }
@@ -84,8 +81,8 @@ fn view_ui(v: &mut Viewer, ui: &mut egui::Ui) {
 
 /// Pictures or measurements: a jittered footprint antialiases, fixed primary hits leave the estimator's error
 /// alone (and a reference rendered the same way).
-fn footprint_ui(v: &mut Viewer, ui: &mut egui::Ui) {
-    let mut fixed = v.settings.footprint == Footprint::Centre;
+fn footprint_ui(s: &mut Session, ui: &mut egui::Ui) {
+    let mut fixed = s.settings().footprint == Footprint::Centre;
     if ui
         .checkbox(&mut fixed, "Fixed primary hits (measure the estimator)")
         .on_hover_text(
@@ -94,14 +91,14 @@ fn footprint_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         )
         .changed()
     {
-        v.set_footprint(if fixed { Footprint::Centre } else { Footprint::Jittered });
+        s.set_footprint(if fixed { Footprint::Centre } else { Footprint::Jittered });
     }
-    ui.small(format!("Errors: {}.", v.settings.footprint.description()));
+    ui.small(format!("Errors: {}.", s.settings().footprint.description()));
 }
 
-fn reference_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+fn reference_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
     ui.heading("Reference");
-    match &v.reference {
+    match s.reference_status() {
         ReferenceStatus::Off => {
             ui.label("none yet");
         }
@@ -114,7 +111,7 @@ fn reference_ui(v: &mut Viewer, ui: &mut egui::Ui) {
                 String::new()
             };
             ui.add(egui::ProgressBar::new(done).text(format!("rendering {spp}/{target} spp{eta}")));
-            ui.small("MIS (projected solid angle + BRDF, power heuristic), its own seed");
+            ui.small(s.reference_description());
         }
         ReferenceStatus::Ready { reference, note } => {
             let spp = if reference.spp > 0 { format!("{} spp, ", reference.spp) } else { String::new() };
@@ -128,20 +125,23 @@ fn reference_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         }
     }
     ui.horizontal(|ui| {
-        ui.add(egui::DragValue::new(&mut v.reference_spp).range(16..=65536).suffix(" spp"));
+        let mut spp = s.reference_spp();
+        if ui.add(egui::DragValue::new(&mut spp).range(16..=65536).suffix(" spp")).changed() {
+            s.set_reference_spp(spp);
+        }
         if ui.button("Compute reference").clicked() {
-            v.compute_reference();
+            s.compute_reference();
         }
     });
     ui.horizontal(|ui| {
         let label = ui.label("EXR");
-        ui.add(egui::TextEdit::singleline(&mut v.reference_path).hint_text("reference .exr").desired_width(150.0))
+        ui.add(egui::TextEdit::singleline(&mut u.reference_path).hint_text("reference .exr").desired_width(150.0))
             .labelled_by(label.id);
-        if ui.button("Load").clicked() && !v.reference_path.trim().is_empty() {
-            v.load_reference(PathBuf::from(v.reference_path.trim()));
+        if ui.button("Load").clicked() && !u.reference_path.trim().is_empty() {
+            s.load_reference(PathBuf::from(u.reference_path.trim()));
         }
-        if ui.add_enabled(v.dialog.is_none(), egui::Button::new("Browse…")).clicked() {
-            v.open_dialog(super::files::FileKind::Reference);
+        if ui.add_enabled(u.dialog.is_none(), egui::Button::new("Browse…")).clicked() {
+            super::files::open_dialog(u, super::files::FileKind::Reference);
         }
     });
 }

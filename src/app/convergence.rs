@@ -2,15 +2,24 @@
 //! seconds, one curve per estimator run in this session, with a 1/√N slope for orientation and the reference's
 //! noise floor; below, efficiency `1/(MSE · s)` per estimator with the winner highlighted.
 
-use super::viewer::Viewer;
+use super::viewer::UiState;
 use crate::measure::{ConvergencePoint, Metric, Series, most_efficient};
+use crate::session::Session;
 use crate::session::worker::ReferenceStatus;
 use egui_plot::{GridMark, HLine, Legend, Line, LineStyle, Plot, PlotPoints, Points};
 
-pub fn convergence_window(v: &mut Viewer, ui: &mut egui::Ui) {
-    let mut open = v.show_plot;
+/// Opens the plot (asking for a reference if there is none), or closes it.
+pub(super) fn toggle_plot(s: &mut Session, u: &mut UiState) {
+    u.show_plot = !u.show_plot;
+    if u.show_plot {
+        s.ensure_reference();
+    }
+}
+
+pub fn convergence_window(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
+    let mut open = u.show_plot;
     egui::Window::new("Convergence").open(&mut open).default_size([760.0, 520.0]).show(ui.ctx(), |ui| {
-        match &v.reference {
+        match s.reference_status() {
             ReferenceStatus::Ready { .. } => {}
             ReferenceStatus::Rendering { spp, target, .. } => {
                 ui.label(format!("Waiting for the reference ({spp}/{target} spp): errors are measured against it."));
@@ -25,40 +34,47 @@ pub fn convergence_window(v: &mut Viewer, ui: &mut egui::Ui) {
                 return;
             }
         }
-        if v.history.iter().all(|s| s.points.is_empty()) {
+        if s.history().iter().all(|r| r.points.is_empty()) {
             ui.label("Runs appear here as they refine.");
             return;
         }
         ui.horizontal(|ui| {
-            ui.radio_value(&mut v.plot_relative, false, "RMSE");
-            ui.radio_value(&mut v.plot_relative, true, "relative RMSE, sqrt(relMSE)");
+            ui.radio_value(&mut u.plot_relative, false, "RMSE");
+            ui.radio_value(&mut u.plot_relative, true, "relative RMSE, sqrt(relMSE)");
         });
         ui.label(format!(
             "Measured with {}; the reference's own noise (dotted) is subtracted.",
-            v.settings.footprint.description()
+            s.settings().footprint.description()
         ));
-        ui.small(if v.plot_relative {
+        ui.small(if u.plot_relative {
             "Each pixel's error relative to its brightness: dark regions count as much as visible lights."
         } else {
             "Absolute error: pixels on the edges of visible lights dominate it, for every estimator alike."
         });
-        let relative = v.plot_relative;
-        let floor = v.reference().map_or(0.0, |r| if relative { r.noise_rel_mse() } else { r.noise_mse() }.sqrt());
+        let relative = u.plot_relative;
+        let floor = s.reference().map_or(0.0, |r| if relative { r.noise_rel_mse() } else { r.noise_mse() }.sqrt());
         let y: fn(&ConvergencePoint) -> f64 = if relative { |p| p.rel_mse.sqrt() } else { |p| p.rmse() };
         let y_label = if relative { "relative RMSE" } else { "RMSE" };
         ui.columns(2, |columns| {
-            plot(&mut columns[0], "rmse-spp", ("samples per pixel", y_label), &v.history, floor, (|p| p.spp as f64, y));
-            plot(&mut columns[1], "rmse-seconds", ("CPU seconds", y_label), &v.history, floor, (|p| p.seconds, y));
+            plot(
+                &mut columns[0],
+                "rmse-spp",
+                ("samples per pixel", y_label),
+                s.history(),
+                floor,
+                (|p| p.spp as f64, y),
+            );
+            plot(&mut columns[1], "rmse-seconds", ("CPU seconds", y_label), s.history(), floor, (|p| p.seconds, y));
         });
-        efficiency_table(ui, &v.history);
-        if v.history.iter().any(|s| s.points.first().is_some_and(|p| p.spp > 1)) {
+        efficiency_table(ui, s.history());
+        if s.history().iter().any(|r| r.points.first().is_some_and(|p| p.spp > 1)) {
             ui.small("Runs that began before the reference was ready start late: press R to record them from 1 spp.");
         }
         if ui.button("Clear runs").clicked() {
-            v.history.clear();
+            s.clear_history();
         }
     });
-    v.show_plot = open;
+    u.show_plot = open;
 }
 
 type Axis = fn(&ConvergencePoint) -> f64;

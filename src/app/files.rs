@@ -3,7 +3,8 @@
 //! reference (`.exr`) onto the window; and a short list of recent scene files, kept in the user's config folder.
 //! The viewer's side of it (what a dropped or picked file opens) is at the end.
 
-use super::viewer::Viewer;
+use super::viewer::{UiState, Viewer};
+use crate::session::Session;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 
@@ -116,57 +117,111 @@ impl RecentFiles {
 impl Viewer {
     /// Keeps the recent scene files in `file` (read now, written on every open); without it they last as long
     /// as the window (the tests' viewers).
-    pub fn set_recent_file(&mut self, file: std::path::PathBuf) {
-        self.recent = RecentFiles::load(file);
+    pub fn set_recent_file(&mut self, file: PathBuf) {
+        self.ui.recent = RecentFiles::load(file);
     }
 
     /// The recent scene files, newest first.
     pub fn recent_files(&self) -> &[String] {
-        &self.recent.entries
+        &self.ui.recent.entries
     }
 
-    /// Opens a native file dialog for a scene or a reference; the choice arrives in a later frame.
-    pub(super) fn open_dialog(&mut self, kind: FileKind) {
-        let start_in = std::path::Path::new(self.open_path.trim()).parent().map(std::path::Path::to_path_buf);
-        let start_in = start_in.filter(|d| d.is_dir());
-        self.dialog = Some(Dialog::open(kind, start_in, self.waker()));
+    /// Keeps the UI's zoom in `file` (read now, written when Ctrl + / − changes it).
+    pub fn set_ui_scale_file(&mut self, file: PathBuf) {
+        self.ui.ui_scale = UiScale::load(file);
+    }
+}
+
+/// The UI's zoom factor (egui's Ctrl + / − / 0), remembered between runs in a one-line file.
+#[derive(Debug, Default)]
+pub struct UiScale {
+    /// The factor last saved or read (`None`: none yet).
+    factor: Option<f32>,
+    file: Option<PathBuf>,
+    /// The factor read was applied to the context.
+    applied: bool,
+}
+
+impl UiScale {
+    /// `$XDG_CONFIG_HOME/illumlab/ui-scale` (or `~/.config/illumlab/ui-scale`).
+    pub fn default_file() -> Option<PathBuf> {
+        RecentFiles::default_file().map(|f| f.with_file_name("ui-scale"))
     }
 
-    /// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads; anything else
-    /// is an error on screen.
-    pub(super) fn take_dropped_files(&mut self, ctx: &egui::Context) {
-        let dropped = ctx.input(|i| i.raw.dropped_files.clone());
-        for file in dropped {
-            let path = file.path().to_path_buf();
-            self.open_file(FileKind::of(&path), path);
+    pub fn load(file: PathBuf) -> Self {
+        let factor = std::fs::read_to_string(&file)
+            .ok()
+            .and_then(|t| t.trim().parse::<f32>().ok())
+            .filter(|f| f.is_finite() && (0.2..=5.0).contains(f));
+        Self { factor, file: Some(file), applied: false }
+    }
+
+    /// Applies the saved factor once; afterwards saves the context's factor whenever it changes.
+    pub(super) fn remember(&mut self, ctx: &egui::Context) {
+        if !self.applied {
+            self.applied = true;
+            if let Some(f) = self.factor {
+                ctx.set_zoom_factor(f);
+                return;
+            }
         }
-        if let Some(dialog) = &self.dialog
-            && let Some(answer) = dialog.poll()
-        {
-            self.dialog = None;
-            match answer {
-                Ok((kind, Some(path))) => self.open_file(Some(kind), path),
-                Ok((_, None)) => {}
-                Err(e) => self.error = Some(e),
+        let now = ctx.zoom_factor();
+        if self.factor.is_some_and(|f| f == now) || (self.factor.is_none() && now == 1.0) {
+            return;
+        }
+        self.factor = Some(now);
+        if let Some(file) = &self.file {
+            if let Some(dir) = file.parent() {
+                let _ = std::fs::create_dir_all(dir);
             }
+            // Not being able to remember the zoom is no reason to interrupt a lecture.
+            let _ = std::fs::write(file, format!("{now}\n"));
         }
     }
+}
 
-    fn open_file(&mut self, kind: Option<FileKind>, path: std::path::PathBuf) {
-        let text = path.to_string_lossy().into_owned();
-        match kind {
-            Some(FileKind::Scene) => {
-                self.open_path = text.clone();
-                self.open(text);
-            }
-            Some(FileKind::Reference) => {
-                self.reference_path = text;
-                self.load_reference(path);
-            }
-            None => {
-                self.error =
-                    Some(format!("cannot open {}: drop a scene (.toml or .obj) or a reference (.exr)", path.display()))
-            }
+/// Opens a native file dialog for a scene or a reference; the choice arrives in a later frame.
+pub(super) fn open_dialog(u: &mut UiState, kind: FileKind) {
+    let start_in = Path::new(u.open_path.trim()).parent().map(Path::to_path_buf);
+    let start_in = start_in.filter(|d| d.is_dir());
+    u.dialog = Some(Dialog::open(kind, start_in, u.waker()));
+}
+
+/// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads, a tour (`.tour.toml`
+/// or a `.toml` with [[step]] tables) is presented; anything else is an error on screen.
+pub(super) fn take_dropped_files(s: &mut Session, u: &mut UiState, ctx: &egui::Context) {
+    let dropped = ctx.input(|i| i.raw.dropped_files.clone());
+    for file in dropped {
+        let path = file.path().to_path_buf();
+        open_file(s, u, FileKind::of(&path), path);
+    }
+    if let Some(dialog) = &u.dialog
+        && let Some(answer) = dialog.poll()
+    {
+        u.dialog = None;
+        match answer {
+            Ok((kind, Some(path))) => open_file(s, u, Some(kind), path),
+            Ok((_, None)) => {}
+            Err(e) => u.error = Some(e),
+        }
+    }
+}
+
+fn open_file(s: &mut Session, u: &mut UiState, kind: Option<FileKind>, path: PathBuf) {
+    let text = path.to_string_lossy().into_owned();
+    match kind {
+        Some(FileKind::Scene) if super::tour::is_tour_file(&path) => super::tour::open_tour(s, u, &text),
+        Some(FileKind::Scene) => {
+            u.open_path = text.clone();
+            u.open(text);
+        }
+        Some(FileKind::Reference) => {
+            u.reference_path = text;
+            s.load_reference(path);
+        }
+        None => {
+            u.error =
+                Some(format!("cannot open {}: drop a scene (.toml or .obj) or a reference (.exr)", path.display()))
         }
     }
 }

@@ -33,3 +33,23 @@ impl Loading {
         }
     }
 }
+
+/// A scene that finished loading replaces the session's; a failure is shown and the current scene stays.
+pub(super) fn poll_loading(s: &mut crate::session::Session, u: &mut super::viewer::UiState) {
+    let Some(result) = u.loading.as_ref().and_then(Loading::poll) else { return };
+    let what = u.loading.take().map(|l| l.what).unwrap_or_default();
+    match result {
+        Ok(scene) => {
+            if std::path::Path::new(&what).is_file()
+                && let Err(e) = u.recent.push(&what)
+            {
+                u.error = Some(e);
+            }
+            u.selected_material = 0;
+            // The scene's warnings are shown under the scene, for as long as it is loaded.
+            u.message = None;
+            s.set_scene(scene, what);
+        }
+        Err(e) => u.error = Some(e.to_string()),
+    }
+}

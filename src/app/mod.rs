@@ -11,6 +11,7 @@ mod orbit;
 mod probe;
 mod shortcuts;
 mod status;
+mod tour;
 mod viewer;
 mod viewport;
 
@@ -37,11 +38,14 @@ pub struct ViewOptions {
     pub probe: Option<(u32, u32)>,
     /// Threads that render passes (`None`: the default, see [`Viewer::with_scene`]).
     pub threads: Option<usize>,
+    /// Present this tour (a file, or `lecture`) from its first step.
+    pub tour: Option<crate::tour::Tour>,
 }
 
 /// Opens the window, already rendering.
 pub fn run(options: ViewOptions) -> anyhow::Result<()> {
     let mut scene = crate::scene::load_scene(&options.scene)?;
+    let source = options.scene.clone();
     if let Some((w, h)) = options.size {
         scene.camera.width = w;
         scene.camera.height = h;
@@ -56,6 +60,7 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
         native,
         Box::new(move |cc| {
             let mut viewer = Viewer::with_threads(std::sync::Arc::new(scene), options.threads);
+            viewer.session_mut().set_source(source);
             viewer.configure(options.settings, options.target_spp, options.exposure);
             viewer.set_reference_spp(options.reference_spp);
             viewer.set_budget(options.budget);
@@ -72,6 +77,12 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
             }
             if let Some(file) = files::RecentFiles::default_file() {
                 viewer.set_recent_file(file);
+            }
+            if let Some(file) = files::UiScale::default_file() {
+                viewer.set_ui_scale_file(file);
+            }
+            if let Some(tour) = options.tour {
+                viewer.present(tour);
             }
             viewer.bind_repaint(cc.egui_ctx.clone());
             Ok(Box::new(viewer))

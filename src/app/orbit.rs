@@ -35,17 +35,6 @@ pub fn zoom(c: &Camera, scale: f32) -> Camera {
     Camera { eye: c.target + offset.normalize() * d, ..*c }
 }
 
-/// The camera at another resolution: `long_side` pixels on its longer side, aspect of `home` kept.
-pub fn with_long_side(c: &Camera, home: &Camera, long_side: u32) -> Camera {
-    let (w, h) = (home.width as f32, home.height as f32);
-    let (width, height) = if w >= h {
-        (long_side, ((long_side as f32 * h / w).round() as u32).max(1))
-    } else {
-        (((long_side as f32 * w / h).round() as u32).max(1), long_side)
-    };
-    Camera { width, height, ..*c }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,11 +72,5 @@ mod tests {
         let z = zoom(&c, 0.5);
         assert!(((z.eye - z.target).length() - 2.0).abs() < 1e-5);
         assert!(zoom(&c, 0.0).validate().is_ok());
-    }
-
-    #[test]
-    fn resolution_keeps_aspect() {
-        let c = with_long_side(&cam(), &cam(), 512);
-        assert_eq!((c.width, c.height), (512, 384));
     }
 }

@@ -4,127 +4,67 @@
 //! that point, and a table that measures every strategy there. The work runs on the probe's own thread
 //! ([`crate::session::probe`]); this is its shell.
 
-use super::viewer::Viewer;
+use super::viewer::{UiState, Viewer};
 use crate::math::luminance;
-use crate::probe::{HISTOGRAM_BINS, HISTOGRAM_DECADES, Layers, PROJECTION, ProbeSettings, chi2};
-use crate::session::probe::{ProbeRequest, ProbeView, ProbeWorker};
-use crate::session::worker::Frame;
+use crate::probe::{HISTOGRAM_BINS, HISTOGRAM_DECADES, PROJECTION, chi2};
+use crate::session::Session;
+use crate::session::probe::ProbeView;
 use egui_plot::{Bar, BarChart, Plot};
 
-/// What the probe panel shows and asks for.
+/// The probe window's own state (what it probes, and how, is the session's).
+#[derive(Default)]
 pub struct ProbeUi {
-    worker: ProbeWorker,
     /// Clicks pick the probe point.
     pub(super) mode: bool,
-    /// The probed pixel and the camera it was picked with.
-    pub(super) pixel: Option<((u32, u32), crate::scene::Camera)>,
-    /// Re-probe the same pixel when the camera moves (else the point stays where it was picked).
-    pub(super) follow: bool,
-    pub(super) settings: ProbeSettings,
-    pub(super) layers: Layers,
-    pub(super) table: bool,
-    pub(super) view: Option<ProbeView>,
-    last_request: Option<ProbeRequest>,
-    textures: Vec<egui::TextureHandle>,
     pub(super) open: bool,
-}
-
-impl ProbeUi {
-    pub fn new(notify: impl Fn() + Send + 'static) -> Self {
-        Self {
-            worker: ProbeWorker::spawn(notify),
-            mode: false,
-            pixel: None,
-            follow: false,
-            settings: ProbeSettings { keep: 2_000, ..Default::default() },
-            layers: Layers::default(),
-            table: false,
-            view: None,
-            last_request: None,
-            textures: Vec::new(),
-            open: false,
-        }
-    }
+    /// The session's answer changed: its pictures must be uploaded again.
+    pub(super) stale: bool,
+    textures: Vec<egui::TextureHandle>,
 }
 
 impl Viewer {
     /// Probes pixel (x, y) of the current camera.
     pub fn set_probe_pixel(&mut self, pixel: (u32, u32)) {
-        self.probe.pixel = Some((pixel, self.camera));
-        self.probe.open = true;
-        self.probe.settings.chi2_samples = 0;
+        probe_pixel(&mut self.session, &mut self.ui, pixel);
     }
 
     /// The newest probe answer on display.
     pub fn probe_view(&self) -> Option<&ProbeView> {
-        self.probe.view.as_ref()
-    }
-
-    /// Sends a new request when what the probe depends on changed, and takes the newest answer.
-    pub(super) fn poll_probe(&mut self, ctx: &egui::Context) {
-        if let Some(view) = self.probe.worker.take() {
-            self.probe.textures = view
-                .lanes
-                .iter()
-                .enumerate()
-                .map(|(i, (_, pic))| {
-                    let image = egui::ColorImage::from_rgba_unmultiplied([pic.width, pic.height], &pic.rgba);
-                    ctx.load_texture(format!("probe {i}"), image, egui::TextureOptions::LINEAR)
-                })
-                .collect();
-            if self.trace {
-                let kind = if self.probe.view.as_ref().and_then(|v| v.point) == view.point {
-                    "same point"
-                } else {
-                    "new point"
-                };
-                eprintln!("trace: probe answered in {:.1} ms ({kind})", view.elapsed.as_secs_f64() * 1e3);
-            }
-            self.probe.view = Some(view);
-        }
-        let Some((pixel, picked_with)) = self.probe.pixel else { return };
-        if self.probe.follow && picked_with != self.camera {
-            self.probe.pixel = Some((pixel, self.camera));
-        }
-        let camera = self.probe.pixel.map_or(self.camera, |p| p.1);
-        let mut lanes = vec![self.settings];
-        let guide_of = |f: Option<&Frame>| f.and_then(|f| f.guide.as_ref()).map(|(_, g)| g.clone());
-        let mut guides = vec![guide_of(self.frame.as_deref())];
-        if self.comparing {
-            lanes.push(self.settings_b);
-            guides.push(guide_of(self.frame_b.as_deref()));
-        }
-        let request = ProbeRequest {
-            scene: self.scene.clone(),
-            camera,
-            pixel,
-            lanes,
-            guides,
-            settings: self.probe.settings,
-            layers: self.probe.layers,
-            table: self.probe.table,
-        };
-        if self.probe.last_request.as_ref() != Some(&request) {
-            self.probe.worker.request(request.clone());
-            self.probe.last_request = Some(request);
-        }
-    }
-
-    /// Where the probe's marker goes: the probed pixel, while the camera is the one it was picked with.
-    pub(super) fn probe_marker(&self) -> Option<(u32, u32)> {
-        self.probe.pixel.filter(|(_, c)| *c == self.camera).map(|(p, _)| p)
-    }
-
-    /// Writes the probe's pictures and numbers beside screenshots; `None` without a probe.
-    pub(super) fn export_probe(&mut self) -> Option<Result<Vec<std::path::PathBuf>, String>> {
-        let view = self.probe.view.as_ref()?;
-        Some(view.export(std::path::Path::new(&self.export_folder)))
+        self.session.probe_view()
     }
 }
 
+/// Probes `pixel` and opens the window.
+pub(super) fn probe_pixel(s: &mut Session, u: &mut UiState, pixel: (u32, u32)) {
+    s.set_probe_pixel(Some(pixel));
+    u.probe.open = true;
+}
+
+/// Uploads the pictures of a new answer.
+pub(super) fn take_probe(s: &Session, u: &mut UiState, ctx: &egui::Context) {
+    if !std::mem::take(&mut u.probe.stale) {
+        return;
+    }
+    let Some(view) = s.probe_view() else { return };
+    u.probe.textures = view
+        .lanes
+        .iter()
+        .enumerate()
+        .map(|(i, (_, pic))| {
+            let image = egui::ColorImage::from_rgba_unmultiplied([pic.width, pic.height], &pic.rgba);
+            ctx.load_texture(format!("probe {i}"), image, egui::TextureOptions::LINEAR)
+        })
+        .collect();
+    if u.trace {
+        eprintln!("trace: probe answered in {:.1} ms", view.elapsed.as_secs_f64() * 1e3);
+    }
+    // A probe set by a tour step or the command line opens the window.
+    u.probe.open |= s.probe_pixel().is_some();
+}
+
 /// The probe window.
-pub fn probe_window(v: &mut Viewer, ui: &mut egui::Ui) {
-    if !v.probe.open {
+pub fn probe_window(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
+    if !u.probe.open {
         return;
     }
     let mut open = true;
@@ -132,24 +72,24 @@ pub fn probe_window(v: &mut Viewer, ui: &mut egui::Ui) {
     egui::Window::new("Probe").open(&mut open).default_size([620.0, 720.0]).default_pos([right - 640.0, 30.0]).show(
         ui.ctx(),
         |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| probe_ui(v, ui));
+            egui::ScrollArea::vertical().show(ui, |ui| probe_ui(s, u, ui));
         },
     );
     if !open {
-        v.probe.open = false;
-        v.probe.pixel = None;
-        v.probe.view = None;
-        v.probe.last_request = None;
+        u.probe.open = false;
+        u.probe.mode = false;
+        s.set_probe_pixel(None);
     }
 }
 
-fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+fn probe_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
+    let mut options = s.probe_options();
     ui.horizontal(|ui| {
-        ui.checkbox(&mut v.probe.mode, "probe mode (I): a click picks the point");
-        ui.checkbox(&mut v.probe.follow, "follow the camera");
+        ui.checkbox(&mut u.probe.mode, "probe mode (I): a click picks the point");
+        ui.checkbox(&mut options.follow, "follow the camera");
     });
     ui.horizontal(|ui| {
-        let l = &mut v.probe.layers;
+        let l = &mut options.layers;
         ui.checkbox(&mut l.integrand, "integrand f L cos");
         ui.checkbox(&mut l.density, "density p");
         ui.checkbox(&mut l.ratio, "ratio");
@@ -159,45 +99,49 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
     });
     ui.horizontal(|ui| {
         // Copies, written back only when moved: a logarithmic slider may round the value it is given.
-        let s = &mut v.probe.settings;
-        let (mut samples, mut keep) = (s.samples, s.keep as u64);
+        let p = &mut options.settings;
+        let (mut samples, mut keep) = (p.samples, p.keep as u64);
         if ui.add(egui::Slider::new(&mut samples, 100..=200_000).logarithmic(true).text("samples")).changed() {
-            s.samples = samples;
+            p.samples = samples;
         }
         if ui.add(egui::Slider::new(&mut keep, 0..=100_000).logarithmic(true).text("dots")).changed() {
-            s.keep = keep as usize;
+            p.keep = keep as usize;
         }
     });
     ui.horizontal(|ui| {
         if ui.button("Chi-square here").clicked() {
-            v.probe.settings.chi2_samples = 200_000;
+            options.settings.chi2_samples = 200_000;
         }
-        ui.checkbox(&mut v.probe.table, "measure every strategy here");
+        ui.checkbox(&mut options.table, "measure every strategy here");
         if ui.button("Save probe (PNG + JSON)").clicked() {
-            match v.export_probe() {
+            match s.probe_view().map(|v| v.export(std::path::Path::new(&u.export_folder))) {
                 Some(Ok(paths)) => {
-                    v.message = Some(format!(
+                    u.message = Some(format!(
                         "saved {}",
                         paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
                     ))
                 }
-                Some(Err(e)) => v.error = Some(format!("probe not saved: {e}")),
+                Some(Err(e)) => u.error = Some(format!("probe not saved: {e}")),
                 None => {}
             }
         }
     });
-    let Some(view) = &v.probe.view else {
+    if options != s.probe_options() {
+        s.set_probe_options(options);
+    }
+    let Some(view) = s.probe_view() else {
         ui.spinner();
         return;
     };
-    let waiting = v.probe.last_request.as_ref() != Some(&view.request);
+    let waiting = !s.probe_is_current();
     let Some(point) = view.point else {
         ui.label(format!("pixel {},{}: the camera ray meets no surface", view.request.pixel.0, view.request.pixel.1));
         return;
     };
-    let material = v.scene.material_names.get(point.material as usize).map_or("?", |s| s.as_str());
+    let scene = s.scene();
+    let material = scene.material_names.get(point.material as usize).map_or("?", |n| n.as_str());
     // In the scene files' coordinates (a scene far from the origin renders rebased).
-    let position = v.scene.origin + point.position.as_dvec3();
+    let position = scene.origin + point.position.as_dvec3();
     ui.label(format!(
         "pixel {},{}  p = ({:.3}, {:.3}, {:.3})  n = ({:.2}, {:.2}, {:.2})  ω_o = ({:.2}, {:.2}, {:.2})  material {material}{}",
         point.pixel.0,
@@ -219,7 +163,7 @@ fn probe_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         ui.small("chi-square rows: draws observed per cell · counts the pdf expects (same log scale) · residual (o − e)/√e from −4 (blue) to +4 (red); MIS: one row per technique");
     }
     ui.separator();
-    let lanes: Vec<_> = view.lanes.iter().zip(&v.probe.textures).collect();
+    let lanes: Vec<_> = view.lanes.iter().zip(&u.probe.textures).collect();
     if let [a, b] = lanes[..] {
         // Compare mode: A and B side by side, at the same point with the same random streams.
         ui.columns(2, |columns| {
@@ -330,4 +274,39 @@ fn numbers_ui(ui: &mut egui::Ui, r: &crate::probe::ProbeReport) {
             plot.bar_chart(BarChart::new("samples", bars));
         },
     );
+}
+
+/// The probe in the presenter view: a panel on the right with each lane's picture and the three numbers that say
+/// which estimator wins at the point, in type readable from the back of a room.
+pub(super) fn presenter_probe_panel(s: &Session, u: &UiState, ui: &mut egui::Ui) {
+    let Some(view) = s.probe_view() else { return };
+    let width = ui.available_width() * 0.42;
+    egui::Panel::right("presenter-probe").resizable(true).default_size(width).show(ui, |ui| {
+        let Some(point) = view.point else {
+            ui.label(egui::RichText::new("the probed pixel sees no surface").size(16.0));
+            return;
+        };
+        let material = s.scene().material_names.get(point.material as usize).map_or("?", |n| n.as_str());
+        ui.label(
+            egui::RichText::new(format!("Probe: pixel {},{} ({material})", point.pixel.0, point.pixel.1)).size(16.0),
+        );
+        ui.small("integrand · density p · ratio, on the hemisphere (centre = n); dots: the last samples");
+        for (((report, picture), texture), lane) in view.lanes.iter().zip(&u.probe.textures).zip(["A", "B"]) {
+            ui.separator();
+            let name = if view.lanes.len() > 1 { format!("{lane}: ") } else { String::new() };
+            ui.label(egui::RichText::new(format!("{name}{}", report.strategy.name())).size(18.0).strong());
+            let w = ui.available_width();
+            ui.image((texture.id(), egui::vec2(w, w * picture.height as f32 / picture.width as f32)));
+            let truth = luminance(report.quadrature.value) as f64;
+            let run = &report.run;
+            let big = |t: String| egui::RichText::new(t).size(16.0);
+            let unconverged = if report.quadrature.budget_reached { ", not converged" } else { "" };
+            ui.label(big(format!(
+                "estimate {:.4} ± {:.4}   (quadrature {truth:.4}{unconverged})",
+                run.mean_luminance(),
+                run.luminance_std_error()
+            )));
+            ui.label(big(format!("σ²/μ² of one sample: {:.3}", run.relative_variance(truth))));
+        }
+    });
 }

@@ -1,12 +1,13 @@
 //! The status bar: progress and the measured rates.
 
-use super::viewer::Viewer;
+use super::viewer::UiState;
+use crate::session::Session;
 
-pub fn status_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+pub fn status_ui(s: &Session, u: &UiState, ui: &mut egui::Ui) {
     ui.horizontal_wrapped(|ui| {
-        let Some(f) = v.frame.clone() else {
+        let Some(f) = s.frame().cloned() else {
             // Before the first frame: starting, or stopped (the error is at the top of the side panel).
-            ui.label(if v.error.is_some() { "not rendering: see the error" } else { "starting…" });
+            ui.label(if u.error.is_some() { "not rendering: see the error" } else { "starting…" });
             return;
         };
         let seconds = f.elapsed.as_secs_f64().max(1e-9);
@@ -48,17 +49,17 @@ pub fn status_ui(v: &mut Viewer, ui: &mut egui::Ui) {
                 ),
             });
         }
-        if let Some(l) = v.restart_latency {
+        if let Some(l) = s.restart_latency() {
             ui.separator();
             ui.label(format!("restart to frame {:.0} ms", l.as_secs_f64() * 1e3));
         }
-        if !v.ui_frame_times.is_empty() {
-            let mut t: Vec<_> = v.ui_frame_times.clone();
+        if !u.ui_frame_times.is_empty() {
+            let mut t: Vec<_> = u.ui_frame_times.clone();
             t.sort();
             ui.separator();
             ui.label(format!("UI {:.1} ms", t[t.len() / 2].as_secs_f64() * 1e3));
         }
-        if v.paused {
+        if s.is_paused() {
             ui.separator();
             ui.strong("paused");
         }

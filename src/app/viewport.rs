@@ -4,26 +4,27 @@
 //! stand side by side; error maps get a legend with their scale.
 
 use super::orbit;
-use super::viewer::Viewer;
+use super::viewer::UiState;
 use crate::measure::gradient;
+use crate::session::Session;
 use crate::session::views::View;
 use crate::session::worker::{A, B};
 
-pub fn viewport_ui(v: &mut Viewer, ui: &mut egui::Ui) {
+pub fn viewport_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
     let ctx = ui.ctx().clone();
-    let [Some(tex_a), tex_b] = v.textures(&ctx) else {
+    let [Some(tex_a), tex_b] = super::frames::textures(s, u, &ctx) else {
         ui.centered_and_justified(|ui| ui.spinner());
         return;
     };
-    let Some(frame) = v.frame.clone() else { return };
-    let legend_height = if v.view == View::Image { 0.0 } else { 44.0 };
+    let Some(frame) = s.frame().cloned() else { return };
+    let legend_height = if s.view() == View::Image { 0.0 } else { 44.0 };
     let mut available = ui.available_size() - egui::vec2(0.0, legend_height);
-    let side_by_side = v.comparing && v.side_by_side && tex_b.is_some();
+    let side_by_side = s.is_comparing() && u.side_by_side && tex_b.is_some();
     if side_by_side {
         available.x = (available.x - 8.0) / 2.0;
     }
     let image_size = egui::vec2(frame.width as f32, frame.height as f32);
-    let scale = if v.one_to_one {
+    let scale = if u.one_to_one {
         1.0 / ui.ctx().pixels_per_point()
     } else {
         (available.x / image_size.x).min(available.y / image_size.y).max(0.01)
@@ -46,35 +47,35 @@ pub fn viewport_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         responses.push(ui.interact(*rect, ui.make_persistent_id(("image", i)), egui::Sense::click_and_drag()));
     }
     let rect = rects[0];
-    v.image_rect = Some(rect);
+    u.image_rect = Some(rect);
     painter.image(tex_a, rect, uv, egui::Color32::WHITE);
     match (tex_b, side_by_side) {
         (Some(tex_b), true) => {
             painter.image(tex_b, rects[1], uv, egui::Color32::WHITE);
         }
-        (Some(tex_b), false) if v.comparing => {
-            let x = rect.min.x + v.wipe * rect.width();
+        (Some(tex_b), false) if s.is_comparing() => {
+            let x = rect.min.x + u.wipe * rect.width();
             let right = egui::Rect::from_min_max(egui::pos2(x, rect.min.y), rect.max);
             painter.with_clip_rect(right).image(tex_b, rect, uv, egui::Color32::WHITE);
-            wipe_handle(v, ui, rect, x);
+            wipe_handle(u, ui, rect, x);
         }
         _ => {}
     }
-    if v.comparing {
-        lane_labels(v, &painter, &rects);
+    if s.is_comparing() {
+        lane_labels(s, &painter, &rects);
     }
-    if let Some(note) = v.view_note.filter(|_| v.view != View::Image) {
+    if let Some(note) = u.view_note.filter(|_| s.view() != View::Image) {
         let at = rect.center_top() + egui::vec2(0.0, 28.0);
-        let text = format!("{}: {note} (showing the image)", v.view.name());
+        let text = format!("{}: {note} (showing the image)", s.view().name());
         painter.text(at, egui::Align2::CENTER_TOP, text, egui::FontId::proportional(14.0), egui::Color32::YELLOW);
     }
-    if v.view != View::Image {
+    if s.view() != View::Image {
         let bar =
             egui::Rect::from_min_size(egui::pos2(area.center().x - 200.0, rect.max.y + 8.0), egui::vec2(400.0, 12.0));
-        legend(v, &painter, bar);
+        legend(s, u, &painter, bar);
     }
 
-    if let Some((x, y)) = v.probe_marker() {
+    if let Some((x, y)) = s.probe_marker() {
         for r in &rects {
             let at = r.min + egui::vec2(x as f32 + 0.5, y as f32 + 0.5) * scale;
             let stroke = egui::Stroke::new(2.0, egui::Color32::from_rgb(90, 200, 255));
@@ -86,12 +87,12 @@ pub fn viewport_ui(v: &mut Viewer, ui: &mut egui::Ui) {
         }
     }
     for (i, response) in responses.iter().enumerate() {
-        pointer(v, ui, response, rects[i], scale, size);
+        pointer(s, u, ui, response, rects[i], scale, size);
     }
 }
 
 /// The wipe line: drag it to move the split.
-fn wipe_handle(v: &mut Viewer, ui: &mut egui::Ui, rect: egui::Rect, x: f32) {
+fn wipe_handle(u: &mut UiState, ui: &mut egui::Ui, rect: egui::Rect, x: f32) {
     let grip = egui::Rect::from_center_size(egui::pos2(x, rect.center().y), egui::vec2(12.0, rect.height()));
     let response = ui
         .interact(grip, ui.make_persistent_id("wipe"), egui::Sense::drag())
@@ -99,7 +100,7 @@ fn wipe_handle(v: &mut Viewer, ui: &mut egui::Ui, rect: egui::Rect, x: f32) {
     if response.dragged()
         && let Some(p) = response.interact_pointer_pos()
     {
-        v.set_wipe((p.x - rect.min.x) / rect.width());
+        u.wipe = ((p.x - rect.min.x) / rect.width()).clamp(0.0, 1.0);
     }
     let stroke =
         egui::Stroke::new(if response.hovered() || response.dragged() { 3.0 } else { 1.5 }, egui::Color32::WHITE);
@@ -108,9 +109,9 @@ fn wipe_handle(v: &mut Viewer, ui: &mut egui::Ui, rect: egui::Rect, x: f32) {
 }
 
 /// "A: strategy, spp" in the top-left and "B: …" in the top-right corner.
-fn lane_labels(v: &Viewer, painter: &egui::Painter, rects: &[egui::Rect]) {
+fn lane_labels(s: &Session, painter: &egui::Painter, rects: &[egui::Rect]) {
     let font = egui::FontId::proportional(14.0);
-    for (lane, frame) in [(A, v.frame.as_deref()), (B, v.frame_b.as_deref())] {
+    for (lane, frame) in [(A, s.frame().map(|f| &**f)), (B, s.frame_b().map(|f| &**f))] {
         let Some(f) = frame else { continue };
         let rect = rects.get(lane).unwrap_or(&rects[0]);
         let (pos, align) = match (lane, rects.len()) {
@@ -132,8 +133,8 @@ fn lane_labels(v: &Viewer, painter: &egui::Painter, rects: &[egui::Rect]) {
 }
 
 /// The colour bar of the error map, its ticks (powers of ten) and what it shows.
-fn legend(v: &Viewer, painter: &egui::Painter, bar: egui::Rect) {
-    let Some(scale) = v.scale.filter(|_| v.view_note.is_none()) else { return };
+fn legend(s: &Session, u: &UiState, painter: &egui::Painter, bar: egui::Rect) {
+    let Some(scale) = u.scale.filter(|_| u.view_note.is_none()) else { return };
     let steps = 64;
     for k in 0..steps {
         let t0 = k as f32 / steps as f32;
@@ -158,28 +159,36 @@ fn legend(v: &Viewer, painter: &egui::Painter, bar: egui::Rect) {
             color,
         );
     }
-    let text = format!("{} (log scale, shared by A and B): {}", v.view.name(), v.view.description());
+    let text = format!("{} (log scale, shared by A and B): {}", s.view().name(), s.view().description());
     painter.text(bar.left_top() - egui::vec2(0.0, 2.0), egui::Align2::LEFT_BOTTOM, text, font, color);
 }
 
 /// Camera and picking on one image rect.
-fn pointer(v: &mut Viewer, ui: &egui::Ui, response: &egui::Response, rect: egui::Rect, scale: f32, size: egui::Vec2) {
+fn pointer(
+    s: &mut Session,
+    u: &mut UiState,
+    ui: &egui::Ui,
+    response: &egui::Response,
+    rect: egui::Rect,
+    scale: f32,
+    size: egui::Vec2,
+) {
     // The probe: a click in probe mode, Ctrl-click, or hovering with I held.
     let pixel_at = |pos: egui::Pos2| {
         let local = (pos - rect.min) / scale;
         (local.x >= 0.0 && local.y >= 0.0).then_some((local.x as u32, local.y as u32))
     };
-    let probing_click = response.clicked() && (v.probe.mode || ui.input(|i| i.modifiers.command));
+    let probing_click = response.clicked() && (u.probe.mode || ui.input(|i| i.modifiers.command));
     let probing_hover =
         response.hovered() && ui.input(|i| i.key_down(egui::Key::I)) && !ui.ctx().egui_wants_keyboard_input();
     if (probing_click || probing_hover)
         && let Some(p) = response.interact_pointer_pos().or(response.hover_pos()).and_then(pixel_at)
     {
-        v.set_probe_pixel(p);
+        super::probe::probe_pixel(s, u, p);
         return;
     }
     if response.double_clicked() {
-        v.reset_camera();
+        s.reset_camera();
         return;
     }
     let drag = response.drag_delta() / size.y;
@@ -188,24 +197,24 @@ fn pointer(v: &mut Viewer, ui: &egui::Ui, response: &egui::Response, rect: egui:
             || response.dragged_by(egui::PointerButton::Middle)
             || ui.input(|i| i.modifiers.shift);
         let camera = if panning {
-            orbit::pan(&v.camera, drag.x, drag.y)
+            orbit::pan(&s.camera(), drag.x, drag.y)
         } else {
-            orbit::orbit(&v.camera, drag.x * std::f32::consts::PI, drag.y * std::f32::consts::PI)
+            orbit::orbit(&s.camera(), drag.x * std::f32::consts::PI, drag.y * std::f32::consts::PI)
         };
-        v.set_camera(camera);
+        s.set_camera(camera);
     }
     if response.hovered() {
         let scroll = ui.input(|i| i.smooth_scroll_delta.y);
         if scroll != 0.0 {
-            v.set_camera(orbit::zoom(&v.camera, (-scroll * 0.002).exp()));
+            s.set_camera(orbit::zoom(&s.camera(), (-scroll * 0.002).exp()));
         }
     }
     if response.secondary_clicked()
         && let Some(pos) = response.interact_pointer_pos()
     {
         let local = (pos - rect.min) / scale;
-        if let Some(t) = v.scene.pick(local.x as u32, local.y as u32) {
-            v.selected_material = v.scene.triangles[t as usize].material as usize;
+        if let Some(t) = s.scene().pick(local.x as u32, local.y as u32) {
+            u.selected_material = s.scene().triangles[t as usize].material as usize;
         }
     }
 }

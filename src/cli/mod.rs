@@ -1,7 +1,8 @@
-//! The headless command line: `render`, `bench`, `probe` and `strategies`.
+//! The headless command line: `render`, `bench`, `probe`, `tour` and `strategies`.
 
 mod bench;
 mod probe;
+mod tour;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -35,6 +36,8 @@ pub enum Command {
     /// Probe one pixel's shading point: the estimate against a quadrature, the chi-square of the sampler there,
     /// and the hemisphere picture.
     Probe(probe::ProbeArgs),
+    /// Render every step of a tour (a lecture's demonstrations) to PNG, with probe pictures and captions.
+    Tour(tour::TourArgs),
     /// List the sampling strategies: name, then a one-line description.
     Strategies,
 }
@@ -126,6 +129,9 @@ pub struct ViewArgs {
     /// Open the probe at pixel X,Y (column from the left, row from the top).
     #[arg(long, value_parser = probe::parse_pixel)]
     pub probe: Option<(u32, u32)>,
+    /// Present a tour from its first step: a tour file, or the bundled lecture without a value.
+    #[arg(long, num_args = 0..=1, default_missing_value = "lecture", value_name = "FILE")]
+    pub tour: Option<String>,
 }
 
 /// The options of `--strategy mis`.
@@ -207,15 +213,11 @@ pub(crate) fn parse_strategy(s: &str) -> Result<Strategy, String> {
 }
 
 fn parse_budget(s: &str) -> Result<Budget, String> {
-    match s {
-        "equal-samples" => Ok(Budget::EqualSamples),
-        "equal-time" => Ok(Budget::EqualTime),
-        _ => Err("unknown budget (equal-samples or equal-time)".into()),
-    }
+    Budget::from_slug(s).ok_or_else(|| "unknown budget (equal-samples or equal-time)".into())
 }
 
 fn parse_view(s: &str) -> Result<View, String> {
-    View::ALL.into_iter().find(|v| v.slug() == s).ok_or_else(|| {
+    View::from_slug(s).ok_or_else(|| {
         let names: Vec<&str> = View::ALL.iter().map(|v| v.slug()).collect();
         format!("unknown view (one of: {})", names.join(", "))
     })
@@ -258,28 +260,34 @@ pub fn run(command: Command) -> Result<()> {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench::bench(args),
         Command::Probe(args) => probe::probe(args),
+        Command::Tour(args) => tour::tour(args),
         Command::View(args) if !args.exposure.is_finite() => bail!("--exposure must be a finite number of stops"),
-        Command::View(args) => illumlab::app::run(illumlab::app::ViewOptions {
-            scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),
-            settings: RenderSettings {
-                strategy: args.strategy,
-                light_selection: args.light_selection,
-                seed: args.seed,
-                mis: args.mis.settings(),
-                footprint: args.footprint,
-                guiding: args.guiding.settings(),
-            },
-            target_spp: args.target_spp,
-            exposure: args.exposure,
-            size: args.size,
-            compare: args.compare,
-            budget: args.budget,
-            view: args.view,
-            reference_spp: args.reference_spp,
-            plot: args.plot,
-            probe: args.probe,
-            threads: args.threads.map(|t| t as usize),
-        }),
+        Command::View(args) => {
+            // A bad tour is one line and a non-zero exit, before any window opens.
+            let tour = args.tour.as_deref().map(illumlab::tour::Tour::load).transpose()?;
+            illumlab::app::run(illumlab::app::ViewOptions {
+                scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),
+                settings: RenderSettings {
+                    strategy: args.strategy,
+                    light_selection: args.light_selection,
+                    seed: args.seed,
+                    mis: args.mis.settings(),
+                    footprint: args.footprint,
+                    guiding: args.guiding.settings(),
+                },
+                target_spp: args.target_spp,
+                exposure: args.exposure,
+                size: args.size,
+                compare: args.compare,
+                budget: args.budget,
+                view: args.view,
+                reference_spp: args.reference_spp,
+                plot: args.plot,
+                probe: args.probe,
+                threads: args.threads.map(|t| t as usize),
+                tour,
+            })
+        }
     }
 }
 

@@ -30,6 +30,18 @@ pub struct CameraBasis {
 }
 
 impl Camera {
+    /// This camera at another resolution: `long_side` pixels on its longer side, with the aspect of `home`.
+    pub fn with_long_side(&self, home: &Camera, long_side: u32) -> Camera {
+        let (w, h) = (home.width as f32, home.height as f32);
+        let long_side = long_side.clamp(1, 16384);
+        let (width, height) = if w >= h {
+            (long_side, ((long_side as f32 * h / w).round() as u32).max(1))
+        } else {
+            (((long_side as f32 * w / h).round() as u32).max(1), long_side)
+        };
+        Camera { width, height, ..*self }
+    }
+
     /// Checks every value; the error names the offending field.
     pub fn validate(&self) -> Result<(), SceneError> {
         let bad = |what: &str| Err(SceneError::Camera(what.to_string()));
@@ -113,6 +125,14 @@ mod tests {
 
     fn cam() -> Camera {
         Camera { eye: Vec3::ZERO, target: -Vec3::Z, up: Vec3::Y, fov_y: 90.0, width: 200, height: 100 }
+    }
+
+    #[test]
+    fn another_resolution_keeps_the_aspect() {
+        let c = cam().with_long_side(&cam(), 512);
+        assert_eq!((c.width, c.height), (512, 256));
+        let tall = Camera { width: 100, height: 200, ..cam() };
+        assert_eq!((c.with_long_side(&tall, 64).width, c.with_long_side(&tall, 64).height), (32, 64));
     }
 
     #[test]

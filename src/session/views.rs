@@ -47,6 +47,10 @@ impl View {
         }
     }
 
+    pub fn from_slug(s: &str) -> Option<Self> {
+        View::ALL.into_iter().find(|v| v.slug() == s)
+    }
+
     /// One line on what the map shows, for the legend.
     pub fn description(self) -> &'static str {
         match self {
@@ -119,4 +123,33 @@ pub fn unavailable(
 /// One scale for all the maps shown together. A map of zeros (identical lanes) has none.
 pub fn shared_scale(maps: &[&[f32]]) -> Option<ColorScale> {
     ColorScale::fit(maps.iter().copied())
+}
+
+/// What is shown of lanes A and B (`None` for a lane without a frame) in `view`: their pixels (RGBA), the one
+/// scale of their error maps, and why the map is not shown (then the image is, at `exposure`).
+pub struct Shown {
+    pub rgba: [Option<Vec<u8>>; 2],
+    pub scale: Option<ColorScale>,
+    pub note: Option<&'static str>,
+}
+
+/// The pixels the viewer (and `illumlab tour`) show for `view`: the error map on a scale shared by both lanes,
+/// or the image at `exposure` where the map is not available.
+pub fn shown(view: View, frames: [Option<&Frame>; 2], reference: Option<&Reference>, exposure: f32) -> Shown {
+    let values: [Option<Vec<f32>>; 2] =
+        [0, 1].map(|i| frames[i].and_then(|f| view_values(view, f, reference, frames[1 - i])));
+    let maps: Vec<&[f32]> = values.iter().flatten().map(|v| v.as_slice()).collect();
+    let scale = shared_scale(&maps);
+    let mut note = frames[0].and_then(|f| unavailable(view, f, reference, frames[1]));
+    if note.is_none() && view != View::Image && scale.is_none() {
+        note = Some("zero everywhere");
+    }
+    let rgba = [0, 1].map(|i| {
+        let frame = frames[i]?;
+        Some(match (&values[i], scale) {
+            (Some(v), Some(scale)) if note.is_none() => scale.colorize(v),
+            _ => super::snapshot::display_rgba(&frame.radiance, exposure),
+        })
+    });
+    Shown { rgba, scale, note }
 }

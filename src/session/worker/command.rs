@@ -21,6 +21,18 @@ impl Budget {
             Budget::EqualTime => "equal time",
         }
     }
+
+    /// The command line's and the tour files' name.
+    pub fn slug(self) -> &'static str {
+        match self {
+            Budget::EqualSamples => "equal-samples",
+            Budget::EqualTime => "equal-time",
+        }
+    }
+
+    pub fn from_slug(s: &str) -> Option<Self> {
+        [Budget::EqualSamples, Budget::EqualTime].into_iter().find(|b| b.slug() == s)
+    }
 }
 
 /// What the UI can ask of the worker.
@@ -62,7 +74,7 @@ pub enum Command {
 
 impl Command {
     /// The generation counters the command bumps: lanes and reference whose image it changes.
-    pub(super) fn resets(&self) -> &'static [usize] {
+    pub(crate) fn resets(&self) -> &'static [usize] {
         match self {
             Command::SetScene(_) | Command::SetCamera(_) | Command::SetMaterial { .. } => &[A, B, R],
             // A change to either lane restarts both: under equal time they must start from zero CPU time together.
