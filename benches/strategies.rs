@@ -1,5 +1,6 @@
-//! Samples per second of a full pass, per strategy, on the bundled scenes (one thread: the per-core rate). Passes
-//! take 16 samples per pixel, as the command line's do (it takes up to 128): enough for the camera-ray cones.
+//! Samples per second of a full pass, per strategy, on two bundled scenes and the real mesh (`assets/knot-box`, 67 200
+//! triangles; one thread: the per-core rate). Passes take 16 samples per pixel, as the command line's do (it takes
+//! up to 128): enough for the camera-ray cones.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use illumlab::render::{Film, RenderSettings, Renderer, Strategy};
@@ -9,8 +10,9 @@ const SPP: u32 = 16;
 
 fn strategies(c: &mut Criterion) {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("thread pool");
-    for name in ["cornell-box", "veach-mis"] {
-        let mut scene = load_scene(name).expect("bundled scene loads");
+    let knot = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/knot-box/knot-box.toml");
+    for (name, source) in [("cornell-box", "cornell-box"), ("veach-mis", "veach-mis"), ("knot-box", knot)] {
+        let mut scene = load_scene(source).expect("the scene loads");
         scene.camera.width = 128;
         scene.camera.height = 128;
         let mut group = c.benchmark_group(format!("pass/{name}"));

@@ -61,6 +61,12 @@ fn every_step_of_the_bundled_tour_renders_headless() {
         assert_eq!(sidecar["title"], step.caption.title.as_str());
         assert_eq!(sidecar["formula"], step.caption.formula.as_str());
         assert_eq!(sidecar["caption"], step.caption.text.as_str());
+        assert!(
+            sidecar["view_note"].is_null(),
+            "{}: the view fell back to the image: {}",
+            out.image.display(),
+            sidecar["view_note"]
+        );
         for probe in &out.probe {
             assert!(image::open(probe).is_ok(), "{} is no picture", probe.display());
         }
@@ -99,7 +105,7 @@ fn the_tour_command_renders_and_a_bad_tour_is_one_line_and_a_failure() {
     assert!(stderr.contains("step 1") && stderr.contains("`strategy`") && stderr.contains("cosinus"), "{stderr}");
     // `view --tour` with a bad tour fails the same way, before a window opens.
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_illumlab"))
-        .args(["view", "--tour", tour.to_str().unwrap()])
+        .args(["view", &format!("--tour={}", tour.display())])
         .output()
         .unwrap();
     assert!(!run.status.success());
@@ -243,4 +249,84 @@ fn a_step_whose_scene_does_not_load_is_an_error_and_the_session_stays() {
     let e = Presenter::start(tour, &mut s).err().expect("an error").to_string();
     assert!(e.contains("step 1 (\"Gone\"), field `scene`"), "{e}");
     assert_eq!(s.source(), "cornell-box");
+}
+
+fn quick() -> TourRender {
+    TourRender {
+        threads: 2,
+        resolution: Some(32),
+        reference_cache: None,
+        reference_spp: 4,
+        timeout: Duration::from_secs(60),
+        ..TourRender::default()
+    }
+}
+
+/// Under equal time each lane stops at the CPU time the first needed for the target: the step is done then.
+#[test]
+fn an_equal_time_step_renders() {
+    let tour = parse_tour(
+        "[[step]]\ntitle = \"T\"\nscene = \"cornell-box\"\nstrategy = \"emitter\"\ncompare = \"projected-solid-angle\"\n\
+         budget = \"equal-time\"\ntarget_spp = 8\n",
+        "t.toml",
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let written = render_tour(&tour, dir.path(), &quick(), |_, _| {}).expect("the equal-time step renders");
+    let sidecar: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&written[0].sidecar).unwrap()).unwrap();
+    let (a, b) = (sidecar["a"]["spp"].as_u64().unwrap(), sidecar["b"]["spp"].as_u64().unwrap());
+    assert!(a >= 8 || b >= 8, "a lane reached the target ({a}, {b})");
+    let (ta, tb) = (sidecar["a"]["cpu_seconds"].as_f64().unwrap(), sidecar["b"]["cpu_seconds"].as_f64().unwrap());
+    assert!(ta > 0.0 && tb > 0.0, "both lanes rendered ({ta} s, {tb} s)");
+}
+
+/// What a later step sets does not leak into an earlier one; cameras fold field by field; a step that names its
+/// scene shows the scene file's camera and materials unless it names its own.
+#[test]
+fn a_step_shows_the_same_whichever_way_it_is_reached() {
+    let tour = parse_tour(
+        "[[step]]\ntitle = \"Home\"\nscene = \"cornell-box\"\n\
+         [[step]]\ntitle = \"Eye\"\nexposure = 2.0\ncamera = { eye = [0.5, 1.0, 3.5] }\n\
+         [[step.material]]\nname = \"glossy\"\nalpha = 500.0\n\
+         [[step]]\ntitle = \"Fov\"\ncamera = { fov_y = 30.0 }\n",
+        "t.toml",
+    )
+    .unwrap();
+    let mut s = session("default");
+    s.set_exposure(-1.0);
+    let mut p = Presenter::start(tour, &mut s).unwrap();
+    let home = s.camera();
+    let glossy = s.scene().materials[3];
+    assert_eq!(s.exposure(), -1.0, "the exposure the tour found");
+    p.go(2, &mut s).unwrap();
+    assert_eq!(s.camera().eye, glam::Vec3::new(0.5, 1.0, 3.5), "step 2's eye stays in step 3");
+    assert_eq!(s.camera().fov_y, 30.0);
+    assert_eq!((s.exposure(), s.scene().materials[3].alpha), (2.0, 500.0));
+    p.go(0, &mut s).unwrap();
+    assert_eq!(s.camera(), home, "back to the scene file's camera");
+    assert_eq!(s.exposure(), -1.0, "step 2's exposure does not leak back");
+    assert_eq!(s.scene().materials[3], glossy, "nor its material");
+    // Jumping to step 3 gives what stepping forwards gave.
+    p.go(2, &mut s).unwrap();
+    assert_eq!((s.camera().eye.x, s.camera().fov_y, s.exposure()), (0.5, 30.0, 2.0));
+}
+
+/// A value that cannot be applied (a material the scene lacks, a probe outside the image) names the step that
+/// set it, also when reached from a later step.
+#[test]
+fn an_error_when_applying_names_the_step_that_set_the_field() {
+    let tour = parse_tour(
+        "[[step]]\ntitle = \"One\"\nscene = \"cornell-box\"\nprobe = [9000, 10]\n\
+         [[step]]\ntitle = \"Two\"\nstrategy = \"cosine\"\n\
+         [[step]]\ntitle = \"Three\"\nprobe = \"off\"\n[[step.material]]\nname = \"marble\"\nalpha = 5.0\n",
+        "t.toml",
+    )
+    .unwrap();
+    let mut s = session("cornell-box");
+    let mut p = Presenter::new(tour, &s);
+    let e = p.go(1, &mut s).unwrap_err().to_string();
+    assert!(e.contains("step 1 (\"One\"), field `probe`") && e.contains("outside"), "{e}");
+    let e = p.go(2, &mut s).unwrap_err().to_string();
+    assert!(e.contains("step 3 (\"Three\"), field `material`") && e.contains("marble"), "{e}");
 }

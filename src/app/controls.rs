@@ -46,7 +46,12 @@ fn scene_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
         ui.add(egui::TextEdit::singleline(&mut u.open_path).hint_text("scene .toml or .obj").desired_width(170.0))
             .labelled_by(label.id);
         if ui.button("Open").clicked() && !u.open_path.trim().is_empty() {
-            u.open(u.open_path.trim().to_string());
+            let path = u.open_path.trim().to_string();
+            if super::tour::is_tour_file(std::path::Path::new(&path)) {
+                super::tour::open_tour(s, u, &path);
+            } else {
+                u.open(path);
+            }
         }
         if ui.add_enabled(u.dialog.is_none(), egui::Button::new("Browse…")).clicked() {
             super::files::open_dialog(u, super::files::FileKind::Scene);
@@ -152,6 +157,9 @@ const MIS_DIRECTIONS: u32 = 4;
 fn sampling_ui(s: &mut Session, u: &mut UiState, ui: &mut egui::Ui) {
     ui.heading("Sampling");
     let mut auto_pass = s.pass_size() == PassSize::Auto;
+    if let PassSize::Fixed(n) = s.pass_size() {
+        u.spp_per_pass = n;
+    }
     let mut target_spp = s.target_spp();
     let mut changed = ui
         .checkbox(&mut auto_pass, "passes sized by time")

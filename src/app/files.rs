@@ -187,8 +187,8 @@ pub(super) fn open_dialog(u: &mut UiState, kind: FileKind) {
     u.dialog = Some(Dialog::open(kind, start_in, u.waker()));
 }
 
-/// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads, a tour (`.tour.toml`
-/// or a `.toml` with [[step]] tables) is presented; anything else is an error on screen.
+/// Files dropped on the window: a scene (`.toml`, `.obj`) opens, a reference (`.exr`) loads, a tour (a `.toml`
+/// with [[step]] tables) is presented; anything else is an error on screen.
 pub(super) fn take_dropped_files(s: &mut Session, u: &mut UiState, ctx: &egui::Context) {
     let dropped = ctx.input(|i| i.raw.dropped_files.clone());
     for file in dropped {

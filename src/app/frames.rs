@@ -24,16 +24,16 @@ pub(super) fn take_frames(s: &mut Session, u: &mut UiState) {
     if update.probed {
         u.probe.stale = true;
     }
-    // A new view or exposure shows at once.
-    if u.shown_with != (s.view(), s.exposure(), s.is_comparing()) {
-        u.shown_with = (s.view(), s.exposure(), s.is_comparing());
-        u.texture_stale = true;
-    }
 }
 
 /// The textures of A (and B when comparing) in the current view and exposure, updated in place.
 pub(super) fn textures(s: &Session, u: &mut UiState, ctx: &egui::Context) -> [Option<egui::TextureId>; 2] {
     let frames = [s.frame().cloned(), s.frame_b().cloned()];
+    // A new view, exposure or compare mode shows at once.
+    if u.shown_with != (s.view(), s.exposure(), s.is_comparing()) {
+        u.shown_with = (s.view(), s.exposure(), s.is_comparing());
+        u.texture_stale = true;
+    }
     if u.refined {
         match u.last_upload.map(|t| t.elapsed()) {
             Some(since) if since < UPLOAD_INTERVAL => ctx.request_repaint_after(UPLOAD_INTERVAL - since),

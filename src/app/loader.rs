@@ -48,6 +48,8 @@ pub(super) fn poll_loading(s: &mut crate::session::Session, u: &mut super::viewe
             u.selected_material = 0;
             // The scene's warnings are shown under the scene, for as long as it is loaded.
             u.message = None;
+            // The probe point was the old scene's.
+            u.probe.open = false;
             s.set_scene(scene, what);
         }
         Err(e) => u.error = Some(e.to_string()),

@@ -33,13 +33,17 @@ enum Move {
 
 fn step(s: &mut Session, u: &mut UiState, m: Move) {
     let Some(p) = u.tour.as_mut() else { return };
-    let last = p.tour.steps.len() - 1;
+    let last = p.tour.steps.len().saturating_sub(1);
     let to = match m {
         Move::Next => (p.index() + 1).min(last),
         Move::Previous => p.index().saturating_sub(1),
         Move::First => 0,
         Move::Last => last,
     };
+    // Page Down on the last step (Page Up on the first) leaves the step, and what the presenter changed, alone.
+    if to == p.index() {
+        return;
+    }
     u.error = p.go(to, s).err().map(|e| e.to_string());
     // The probe's window opens with a step that probes, and closes with one that does not.
     u.probe.open = s.probe_pixel().is_some();
@@ -165,7 +169,7 @@ pub(super) fn present(s: &mut Session, u: &mut UiState, tour: Tour) {
         }
         Err(e) => {
             u.error = Some(e.to_string());
-            u.tour = Some(Presenter::new(tour));
+            u.tour = (!tour.steps.is_empty()).then(|| Presenter::new(tour, s));
         }
     }
     u.presenter_view = true;

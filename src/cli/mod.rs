@@ -129,8 +129,8 @@ pub struct ViewArgs {
     /// Open the probe at pixel X,Y (column from the left, row from the top).
     #[arg(long, value_parser = probe::parse_pixel)]
     pub probe: Option<(u32, u32)>,
-    /// Present a tour from its first step: a tour file, or the bundled lecture without a value.
-    #[arg(long, num_args = 0..=1, default_missing_value = "lecture", value_name = "FILE")]
+    /// Present a tour from its first step: `--tour=FILE`, or the bundled lecture with `--tour` alone.
+    #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "lecture", value_name = "FILE")]
     pub tour: Option<String>,
 }
 

@@ -165,3 +165,84 @@ pub fn estimate_light_lanes(
     let visible = visible_lanes(scene, near, (x, n_x), (&light_error, groups), shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
+
+/// Veach's multi-sample MIS with one direction from a light technique and one from a BRDF technique
+/// (`MisSettings::samples` = [1, 1]) for up to eight samples of one pixel: what [`super::strategy::mis`]'s estimator
+/// gives each sample, bit for bit. Per lane, the light technique draws first and the BRDF technique second from
+/// the sample's own stream, as there; each weight needs only the two densities, so it is computed before the
+/// rays are traced. The light directions' shadow rays then go together ([`visible_lanes`]); the BRDF directions
+/// are traced one after the other (as is a first technique's direction that is not aimed at a light). Adds the
+/// rays traced to `rays`.
+#[inline]
+pub fn estimate_mis_lanes(
+    ctx: &SampleContext,
+    (light, brdf): (&impl Technique, &impl Technique),
+    dirs: &Vec3x8,
+    hits: &HitLanes,
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    use super::estimator::integrand;
+    use super::strategy::Reached;
+    use super::strategy::mis::technique_context;
+    let scene = ctx.scene;
+    let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
+    let heuristic = ctx.mis.heuristic;
+    let mut emitted = [Vec3::ZERO; LANES];
+    // Each lane's first direction's contribution, weighted (if its shadow ray, in `shadow_rays`, gets through),
+    // and the shadow ray's ends.
+    let mut first = [Vec3::ZERO; LANES];
+    let mut ends = [[Vec3::ZERO; LANES]; 4];
+    let (mut p_error, mut light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
+    let mut groups = [SKIP_NONE; LANES];
+    let mut shadow_rays = 0;
+    let mut shading = [None; LANES];
+    for l in 0..LANES {
+        let Some(hit) = hits.lane(l) else { continue };
+        let tri = &scene.triangles[hit.triangle as usize];
+        let wo = -dirs.lane(l);
+        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
+        emitted[l] = scene.emitted(hit.triangle, wo);
+        if let Some(s) = light.sample(&contexts[0], &sp, &mut rngs[l]) {
+            let Target::Emitter { triangle, point } = s.target else {
+                if let Ok((value, via)) = integrand(scene, &sp, &s, rays) {
+                    let w = heuristic.weight(1, s.pdf, 1, brdf.pdf(&contexts[1], &sp, s.wi, Some(via)));
+                    first[l] = value * (w / (1.0 * s.pdf));
+                }
+                shading[l] = Some(sp);
+                continue;
+            };
+            if let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) {
+                let p_other = brdf.pdf(&contexts[1], &sp, s.wi, Some(Reached { triangle, point }));
+                let w = heuristic.weight(1, s.pdf, 1, p_other);
+                first[l] = value * (w / (1.0 * s.pdf));
+                (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
+                (p_error[l], light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
+                groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
+                shadow_rays |= 1 << l;
+            }
+        }
+        shading[l] = Some(sp);
+    }
+    // The BRDF directions, each drawn after its lane's light direction, traced one by one.
+    let mut from_brdf = [Vec3::ZERO; LANES];
+    for l in 0..LANES {
+        let Some(sp) = &shading[l] else { continue };
+        let Some(s) = brdf.sample(&contexts[1], sp, &mut rngs[l]) else { continue };
+        if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
+            let p_other = light.pdf(&contexts[0], sp, s.wi, Some(via));
+            let w = heuristic.weight(1, s.pdf, 1, p_other);
+            from_brdf[l] = value * (w / (1.0 * s.pdf));
+        }
+    }
+    let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
+    let near = (p, n, f32x8::new(p_error));
+    let visible = visible_lanes(scene, near, (x, n_x), (&light_error, groups), shadow_rays, rays);
+    std::array::from_fn(|l| {
+        let shadowed = shadow_rays & !visible & (1 << l) != 0;
+        let mut total = Vec3::ZERO;
+        total += if shadowed { Vec3::ZERO } else { first[l] };
+        total += from_brdf[l];
+        emitted[l] + total
+    })
+}

@@ -2,9 +2,9 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
-use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes};
+use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes, estimate_mis_lanes};
 use super::sink::{Census, Learner};
-use super::strategy::{MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
+use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::guiding::{Guide, GuideRecord, GuideSettings, Training};
 use crate::math::{PixelStreams, SampleRng};
@@ -376,6 +376,23 @@ impl Renderer {
                     _ => estimate_light_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
                 }
             }
+            // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
+            (Strategy::Mis, _)
+                if learned.is_none() && self.settings.mis.is_valid() && self.settings.mis.samples == [1, 1] =>
+            {
+                let mut rngs = std::array::from_fn(|l| rngs.lane(l));
+                let ctx = self.context();
+                let lanes = (&dirs, &hits, &mut rngs, rays);
+                // The usual pairs with their techniques' code inlined, as MIS's own estimator has them.
+                match self.settings.mis.techniques {
+                    [Strategy::Emitter, Strategy::Brdf] => mis_lanes(&ctx, (&Emitter, &Brdf), lanes),
+                    [Strategy::SolidAngle, Strategy::Brdf] => mis_lanes(&ctx, (&SolidAngle, &Brdf), lanes),
+                    [Strategy::ProjectedSolidAngle, Strategy::Brdf] => {
+                        mis_lanes(&ctx, (&ProjectedSolidAngle, &Brdf), lanes)
+                    }
+                    [a, b] => mis_lanes(&ctx, (&a, &b), lanes),
+                }
+            }
             _ => std::array::from_fn(|l| {
                 hits.lane(l).map_or(Vec3::ZERO, |hit| {
                     self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays, learned.as_deref_mut())
@@ -412,9 +429,20 @@ impl Renderer {
     }
 }
 
+/// [`estimate_mis_lanes`] with the lanes' arguments in one tuple.
+#[inline(always)]
+fn mis_lanes(
+    ctx: &SampleContext,
+    techniques: (&impl super::strategy::Technique, &impl super::strategy::Technique),
+    (dirs, hits, rngs, rays): (&crate::math::Vec3x8, &HitLanes, &mut [SampleRng; LANES], &mut u64),
+) -> [Vec3; LANES] {
+    estimate_mis_lanes(ctx, techniques, dirs, hits, rngs, rays)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::Heuristic;
     use crate::scene::every_bundled_scene;
 
     /// A renderer takes an earlier one's pixel cones for its own camera only, and renders with them what it
@@ -445,8 +473,9 @@ mod tests {
 
     /// Thirteen samples per pixel in one pass (through each pixel's cone, eight lanes then five), in thirteen
     /// passes of one (a full traversal and the one-sample estimator each) and in passes of three and ten give the
-    /// same film bit for bit: on every bundled scene, with every registered strategy (the light strategies take
-    /// the eight-lane estimators), with every light selection for the light strategies, and with both
+    /// same film bit for bit: on every bundled scene, with every registered strategy (the light strategies and MIS
+    /// take the eight-lane estimators), with every light selection for the light strategies, with MIS's other
+    /// technique pairs and heuristic and with a direction split the eight-lane path does not take, and with both
     /// footprints.
     #[test]
     fn any_split_into_passes_gives_the_same_film() {
@@ -466,6 +495,20 @@ mod tests {
                 footprint: Footprint::Centre,
                 ..Default::default()
             }))
+            .chain(
+                [
+                    ([Strategy::SolidAngle, Strategy::Brdf], Heuristic::Power, [1, 1]),
+                    ([Strategy::ProjectedSolidAngle, Strategy::Brdf], Heuristic::Balance, [1, 1]),
+                    ([Strategy::Cosine, Strategy::Brdf], Heuristic::Power, [1, 1]),
+                    ([Strategy::Brdf, Strategy::Emitter], Heuristic::Power, [1, 1]),
+                    ([Strategy::Emitter, Strategy::Brdf], Heuristic::Power, [2, 1]),
+                ]
+                .map(|(techniques, heuristic, samples)| RenderSettings {
+                    strategy: Strategy::Mis,
+                    mis: MisSettings { techniques, heuristic, samples },
+                    ..Default::default()
+                }),
+            )
             .collect();
         for (name, scene, camera) in every_bundled_scene(48, 36) {
             let scene = Arc::new(scene);
@@ -490,10 +533,11 @@ mod tests {
                 for passes in [&[13][..], &[3, 10], &[5, 8]] {
                     assert!(
                         film(passes).pixels == one_by_one.pixels,
-                        "{name}, {} ({}, {}): passes {passes:?} differ from one sample at a time",
+                        "{name}, {} ({}, {}, {}): passes {passes:?} differ from one sample at a time",
                         settings.strategy.name(),
                         settings.light_selection.name(),
-                        settings.footprint.name()
+                        settings.footprint.name(),
+                        settings.mis.label()
                     );
                 }
             }

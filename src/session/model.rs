@@ -73,6 +73,8 @@ pub struct Session {
     reference: ReferenceStatus,
     reference_spp: u32,
     reference_cache: Option<PathBuf>,
+    /// Compare mode asks for a reference (for its error maps and plot); off for `illumlab tour`.
+    reference_for_compare: bool,
     /// Convergence runs against the current reference, one per estimator, in the order first seen.
     history: Vec<Series>,
     frames: [Option<Arc<Frame>>; 2],
@@ -123,6 +125,7 @@ impl Session {
             reference: ReferenceStatus::Off,
             reference_spp: 1024,
             reference_cache: crate::measure::default_cache_folder(),
+            reference_for_compare: true,
             history: Vec::new(),
             frames: [None, None],
             restarted_at: [0; 2],
@@ -247,13 +250,23 @@ impl Session {
         self.probe_view.as_ref().is_some_and(|v| self.last_request.as_ref() == Some(&v.request))
     }
 
-    /// Both lanes shown (A, and B in compare mode) have frames of their current settings, past the preview, with
-    /// at least `spp` samples per pixel.
+    /// Both lanes shown (A, and B in compare mode) have frames of their current settings, past the preview, and
+    /// are done with `spp` samples per pixel: at `spp`, or under equal time in compare mode, at the CPU time the
+    /// first lane to reach `spp` needed (where the worker stops them).
     pub fn reached(&self, spp: u32) -> bool {
-        let lanes: &[usize] = if self.comparing { &[A, B] } else { &[A] };
-        lanes.iter().all(|&l| {
-            self.frames[l].as_ref().is_some_and(|f| f.generation >= self.restarted_at[l] && !f.preview && f.spp >= spp)
-        })
+        let current = |l: usize| self.frames[l].as_ref().filter(|f| f.generation >= self.restarted_at[l] && !f.preview);
+        if !self.comparing {
+            return current(A).is_some_and(|f| f.spp >= spp);
+        }
+        let (Some(a), Some(b)) = (current(A), current(B)) else { return false };
+        match self.budget {
+            Budget::EqualSamples => a.spp >= spp && b.spp >= spp,
+            Budget::EqualTime => {
+                let done =
+                    |f: &Frame, other: &Frame| f.spp >= spp || (other.spp >= spp && f.stats.cpu >= other.stats.cpu);
+                done(a, b) && done(b, a)
+            }
+        }
     }
 
     // ----- what it does -----
@@ -299,7 +312,10 @@ impl Session {
             }
             *shown = Some(frame);
         }
-        if let Some(view) = self.probe_worker.take() {
+        // An answer that arrives after the probe was closed (or the scene changed) is dropped.
+        if let Some(view) = self.probe_worker.take()
+            && self.probe_pixel.is_some()
+        {
             self.probe_view = Some(view);
             update.probed = true;
         }
@@ -380,9 +396,24 @@ impl Session {
         self.comparing = on;
         self.frames[B] = None;
         self.send_compare();
-        if on {
+        if on && self.reference_for_compare {
             self.ensure_reference();
         }
+    }
+
+    /// Compare mode with B = `strategy` (one restart).
+    pub fn compare_with(&mut self, strategy: Strategy) {
+        if self.comparing {
+            self.set_strategy_b(strategy);
+        } else {
+            self.settings_b.strategy = strategy;
+            self.set_comparing(true);
+        }
+    }
+
+    /// Whether entering compare mode asks for a reference (a view that needs one always does).
+    pub fn set_reference_for_compare(&mut self, on: bool) {
+        self.reference_for_compare = on;
     }
 
     /// Swaps the estimators of A and B (both restart; with common random numbers they reconverge identically).

@@ -137,8 +137,13 @@ fn parse_step(t: &Table, n: usize, file: &str) -> Result<Step, TourError> {
                 step.view = Some(View::from_slug(&s).ok_or_else(|| fail(unknown("view", &s, &names)))?);
             }
             "exposure" => step.exposure = Some(number(value, -20.0, 20.0).map_err(fail)? as f32),
-            "resolution" => step.resolution = Some(whole(value, 8, 4096).map_err(fail)? as u32),
-            "target_spp" => step.target_spp = Some(whole(value, 1, 1 << 20).map_err(fail)? as u32),
+            "resolution" => step.resolution = Some(whole(value, 1, 16384).map_err(fail)? as u32),
+            "target_spp" => {
+                step.target_spp = Some(match value {
+                    Value::String(s) if s == "off" => None,
+                    _ => Some(whole(value, 1, 1_000_000).map_err(|p| fail(format!("{p} (or \"off\")")))? as u32),
+                })
+            }
             "seed" => step.seed = Some(whole(value, 0, i64::MAX).map_err(fail)? as u64),
             "camera" => step.camera = Some(CameraStep::parse(value).map_err(fail)?),
             "probe" => {
@@ -292,7 +297,7 @@ pub fn step_toml(step: &Step) -> String {
         t.insert("exposure".into(), Value::Float(e as f64));
     }
     if let Some(n) = step.target_spp {
-        t.insert("target_spp".into(), Value::Integer(n as i64));
+        t.insert("target_spp".into(), n.map_or(s("off"), |n| Value::Integer(n as i64)));
     }
     if let Some(p) = step.probe {
         let v = p.map_or(s("off"), |(x, y)| Value::Array(vec![Value::Integer(x as i64), Value::Integer(y as i64)]));

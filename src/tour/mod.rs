@@ -84,12 +84,6 @@ pub struct Caption {
     pub text: String,
 }
 
-impl Caption {
-    pub fn is_empty(&self) -> bool {
-        self.title.is_empty() && self.formula.is_empty() && self.text.is_empty()
-    }
-}
-
 /// One demonstration. Every setting is optional: `None` keeps what the session has.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Step {
@@ -109,8 +103,8 @@ pub struct Step {
     /// `Some(Some(pixel))` probes that pixel; `Some(None)` closes the probe.
     pub probe: Option<Option<(u32, u32)>>,
     pub layers: Option<Layers>,
-    /// Refining stops here (and `illumlab tour` renders this many samples per pixel).
-    pub target_spp: Option<u32>,
+    /// Refining stops here (and `illumlab tour` renders this many samples per pixel); `Some(None)`: never.
+    pub target_spp: Option<Option<u32>>,
     pub light_selection: Option<LightSelection>,
     pub footprint: Option<Footprint>,
     pub seed: Option<u64>,

@@ -67,12 +67,15 @@ pub fn render_tour(
     std::fs::create_dir_all(out).map_err(|e| fail(format!("cannot create {}: {e}", out.display())))?;
     let first = tour.steps.iter().find_map(|s| s.scene.clone()).unwrap_or_else(|| crate::scene::DEFAULT_SCENE.into());
     let scene = load_scene(&first).map_err(|e| {
-        TourError::new(&tour.file, Some((1, tour.steps[0].caption.title.clone())), Some("scene"), e.to_string())
+        let at = tour.steps.iter().position(|s| s.scene.is_some()).unwrap_or(0);
+        TourError::new(&tour.file, Some((at + 1, tour.steps[at].caption.title.clone())), Some("scene"), e.to_string())
     })?;
     let mut session = Session::headless(Arc::new(scene), first, options.threads);
     session.set_reference_cache(options.reference_cache.clone());
     session.set_reference_spp(options.reference_spp);
-    let presenter = Presenter::new(tour.clone());
+    // Only a step that shows the error against a reference renders one.
+    session.set_reference_for_compare(false);
+    let presenter = Presenter::new(tour.clone(), &session);
     let mut written = Vec::new();
     for index in 0..tour.steps.len() {
         let mut step = presenter.effective(index);
@@ -81,7 +84,8 @@ pub fn render_tour(
         let native = step.resolution;
         step.resolution = options.resolution.or(native);
         let step_error = |(field, problem): (&str, String)| {
-            TourError::new(&tour.file, Some((index + 1, tour.steps[index].caption.title.clone())), Some(field), problem)
+            let from = (0..=index).rev().find(|&i| tour.steps[i].names(field)).unwrap_or(index);
+            TourError::new(&tour.file, Some((from + 1, tour.steps[from].caption.title.clone())), Some(field), problem)
         };
         step.apply(&mut session).map_err(step_error)?;
         if let Some(pixel) = probe {
@@ -92,9 +96,8 @@ pub fn render_tour(
             let probe_step = super::Step { probe: Some(pixel), ..Default::default() };
             probe_step.apply(&mut session).map_err(step_error)?;
         }
-        let target = options.max_spp.map_or(session.target_spp().unwrap_or(options.spp), |m| {
-            m.min(session.target_spp().unwrap_or(options.spp))
-        });
+        let target = session.target_spp().unwrap_or(options.spp);
+        let target = options.max_spp.map_or(target, |m| m.min(target));
         session.set_sampling(session.pass_size(), Some(target));
         let step = &tour.steps[index];
         let at =

@@ -28,7 +28,7 @@ impl CameraStep {
                 "eye" => c.eye = Some(triple(v, -1e7, 1e7).map_err(at)?),
                 "target" => c.target = Some(triple(v, -1e7, 1e7).map_err(at)?),
                 "up" => c.up = Some(triple(v, -1e7, 1e7).map_err(at)?),
-                "fov_y" => c.fov_y = Some(number(v, 0.01, 179.0).map_err(at)? as f32),
+                "fov_y" => c.fov_y = Some(number(v, 1e-3, 179.999).map_err(at)? as f32),
                 _ => return Err(format!("unknown camera field `{k}` (eye, target, up, fov_y)")),
             }
         }
@@ -172,6 +172,18 @@ fn table<'a>(v: &'a Value, shape: &str) -> Result<&'a Table, String> {
 }
 
 impl Step {
+    /// Whether this step sets `field` (a tour file's name for it).
+    pub fn names(&self, field: &str) -> bool {
+        match field {
+            "scene" => self.scene.is_some(),
+            "camera" => self.camera.is_some(),
+            "material" => !self.materials.is_empty(),
+            "probe" => self.probe.is_some(),
+            "resolution" => self.resolution.is_some(),
+            _ => false,
+        }
+    }
+
     /// This step followed by `later`: what `later` names wins. A step that opens another scene drops the camera,
     /// materials and probe pixel of the steps before it (they belong to the other scene). The caption is
     /// `later`'s.
@@ -188,7 +200,15 @@ impl Step {
             budget: later.budget.or(self.budget),
             view: later.view.or(self.view),
             exposure: later.exposure.or(self.exposure),
-            camera: later.camera.or(self.camera.filter(|_| earlier(true))),
+            camera: match (self.camera.filter(|_| earlier(true)), later.camera) {
+                (Some(a), Some(b)) => Some(CameraStep {
+                    eye: b.eye.or(a.eye),
+                    target: b.target.or(a.target),
+                    up: b.up.or(a.up),
+                    fov_y: b.fov_y.or(a.fov_y),
+                }),
+                (a, b) => b.or(a),
+            },
             resolution: later.resolution.or(self.resolution),
             probe: later.probe.or(if earlier(true) { self.probe } else { Some(None) }),
             layers: later.layers.or(self.layers),
@@ -211,11 +231,22 @@ impl Step {
     /// Sets the session to this step: what the step names changes, everything else stays. A scene other than
     /// the session's is loaded here (bundled scenes take milliseconds). The error names the field.
     pub fn apply(&self, s: &mut Session) -> Result<(), (&'static str, String)> {
-        if let Some(scene) = &self.scene
-            && scene != s.source()
-        {
-            let loaded = load_scene(scene).map_err(|e| ("scene", e.to_string()))?;
-            s.set_scene(loaded, scene.clone());
+        if let Some(scene) = &self.scene {
+            if scene != s.source() {
+                let loaded = load_scene(scene).map_err(|e| ("scene", e.to_string()))?;
+                s.set_scene(loaded, scene.clone());
+            }
+            // The scene as its file has it, but for what the step names (a step shows the same however reached).
+            if self.camera.is_none() {
+                s.reset_camera();
+            }
+            for (i, home) in s.home_materials().to_vec().into_iter().enumerate() {
+                let named =
+                    s.scene().material_names.get(i).is_some_and(|n| self.materials.iter().any(|m| m.name == *n));
+                if !named {
+                    s.set_material(i, home);
+                }
+            }
         }
         if let Some(r) = self.resolution {
             s.set_resolution(r);
@@ -249,10 +280,7 @@ impl Step {
             guiding: a.guiding,
         });
         match self.compare {
-            Some(Some(b)) => {
-                s.set_strategy_b(b);
-                s.set_comparing(true);
-            }
+            Some(Some(b)) => s.compare_with(b),
             Some(None) => s.set_comparing(false),
             None => {}
         }
@@ -266,7 +294,7 @@ impl Step {
             s.set_exposure(e);
         }
         if let Some(n) = self.target_spp {
-            s.set_sampling(s.pass_size(), Some(n));
+            s.set_sampling(s.pass_size(), n);
         }
         if let Some(p) = self.probe {
             let c = s.camera();
@@ -304,7 +332,7 @@ impl Step {
             .collect();
         Step {
             caption,
-            scene: Some(s.source().to_string()),
+            scene: Some(absolute_unless_bundled(s.source())),
             strategy: Some(a.strategy),
             compare: Some(s.is_comparing().then_some(s.settings_b().strategy)),
             budget: Some(s.budget()),
@@ -319,7 +347,7 @@ impl Step {
             resolution: Some(camera.width.max(camera.height)),
             probe: Some(s.probe_pixel()),
             layers: s.probe_pixel().map(|_| s.probe_options().layers),
-            target_spp: s.target_spp(),
+            target_spp: Some(s.target_spp()),
             light_selection: Some(a.light_selection),
             footprint: Some(a.footprint),
             seed: Some(a.seed),
@@ -331,4 +359,12 @@ impl Step {
             materials,
         }
     }
+}
+
+/// A scene file's absolute path (a saved step loads from any tour file's folder); a bundled scene's name as it is.
+fn absolute_unless_bundled(source: &str) -> String {
+    if crate::scene::BUNDLED_SCENES.iter().any(|b| b.name == source) {
+        return source.to_string();
+    }
+    std::path::absolute(source).map_or_else(|_| source.to_string(), |p| p.to_string_lossy().into_owned())
 }

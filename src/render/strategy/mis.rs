@@ -215,7 +215,7 @@ struct TechniqueStates([Option<StrategyState>; 2]);
 
 /// The context technique i sees: MIS's, with the technique's own state.
 #[inline(always)]
-fn technique_context<'a>(ctx: &SampleContext<'a>, i: usize) -> SampleContext<'a> {
+pub(crate) fn technique_context<'a>(ctx: &SampleContext<'a>, i: usize) -> SampleContext<'a> {
     let state = ctx.state::<TechniqueStates>().and_then(|s| s.0[i].as_deref());
     SampleContext { state, ..*ctx }
 }

@@ -18,7 +18,9 @@ mod projected_solid_angle;
 mod solid_angle;
 mod uniform;
 
+pub(crate) use brdf::Brdf;
 pub use brdf_polygon::BrdfPolygon;
+pub(crate) use emitter::Emitter;
 pub use mis::{Heuristic, MisSettings};
 pub use projected_solid_angle::ProjectedSolidAngle;
 pub use solid_angle::SolidAngle;
