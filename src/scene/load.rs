@@ -252,6 +252,8 @@ impl Meshes {
                 let i = 3 * i as usize;
                 DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
             };
+            self.positions.reserve(mesh.indices.len() / 3);
+            self.material_ids.reserve(mesh.indices.len() / 3);
             for f in mesh.indices.chunks_exact(3) {
                 self.positions.push([vertex(f[0]), vertex(f[1]), vertex(f[2])]);
                 self.material_ids.push(material);

@@ -36,8 +36,18 @@ pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
     let bvh = build_bvh2_from_tris(&input, BvhBuildParams::medium_build(), &mut Duration::default());
     // Group ids are non-negative as i32; NO_GROUP and SKIP_NOTHING are negative.
     let groups = groups.iter().map(|g| g.map_or(NO_GROUP, |g| i32::try_from(g).expect("group id below 2³¹"))).collect();
-    let mut builder =
-        Builder { bvh: &bvh, positions, groups, nodes: vec![], child_groups: vec![], packets: vec![], order: vec![] };
+    // Reserved ahead (a binary tree of n leaves collapses to about a seventh as many wide nodes; a packet holds
+    // up to eight triangles): growing these by doubling took 7% of a 1M-triangle load in copies and page faults.
+    let wide = bvh.nodes.len() / 7 + 1;
+    let mut builder = Builder {
+        bvh: &bvh,
+        positions,
+        groups,
+        nodes: Vec::with_capacity(wide),
+        child_groups: Vec::with_capacity(wide),
+        packets: Vec::with_capacity(positions.len() / 4 + 1),
+        order: Vec::with_capacity(positions.len()),
+    };
     let (root, _) = builder.child(0, 0);
     let (nodes, groups, packets, order) = (builder.nodes, builder.child_groups, builder.packets, builder.order);
     Built { nodes, groups, packets, root, order }
