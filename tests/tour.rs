@@ -105,11 +105,22 @@ fn the_tour_command_renders_and_a_bad_tour_is_one_line_and_a_failure() {
     assert!(stderr.contains("step 1") && stderr.contains("`strategy`") && stderr.contains("cosinus"), "{stderr}");
     // `view --tour` with a bad tour fails the same way, before a window opens.
     let run = std::process::Command::new(env!("CARGO_BIN_EXE_illumlab"))
-        .args(["view", &format!("--tour={}", tour.display())])
+        .args(["view", "--tour", tour.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(!run.status.success());
     assert!(String::from_utf8_lossy(&run.stderr).contains("`strategy`"));
+    // A bundled scene's name after --tour is a mistake of order, said so.
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_illumlab"))
+        .args(["view", "--tour", "cornell-box"])
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains("put it before --tour"),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }
 
 /// Each malformed tour, and the step and field its one error must name.

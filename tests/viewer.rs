@@ -306,14 +306,10 @@ fn compare_mode_swap_wipe_budgets_and_export() {
     h.step();
     assert_eq!(h.state().budget(), illumlab::session::worker::Budget::EqualSamples);
 
-    // Both lanes past the restart of the budget change (their generations agree), each with a recorded run.
+    // Both lanes past the restart of the budget change (frames of the current settings: `reached`), each with a
+    // recorded run.
     step_until(&mut h, "the reference and a recorded run", |v| {
-        let (Some(a), Some(b)) = (v.frame(), v.frame_b()) else { return false };
-        a.generation == b.generation
-            && a.spp >= 2
-            && b.spp >= 2
-            && v.reference().is_some()
-            && v.history().iter().any(|s| s.points.len() >= 2)
+        v.session().reached(2) && v.reference().is_some() && v.history().iter().any(|s| s.points.len() >= 2)
     });
     // The convergence window: its plots, the efficiency table and the winner (kittest also fails on any glyph the
     // fonts cannot draw).

@@ -231,8 +231,8 @@ impl Viewer {
         if let Some(last) = u.last_ui_start.replace(start) {
             u.ui_intervals.push(start - last);
         }
-        if u.repaint.lock().is_ok_and(|c| c.is_none())
-            && let Ok(mut slot) = u.repaint.lock()
+        if let Ok(mut slot) = u.repaint.lock()
+            && slot.is_none()
         {
             *slot = Some(ui.ctx().clone());
         }

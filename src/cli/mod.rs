@@ -129,8 +129,9 @@ pub struct ViewArgs {
     /// Open the probe at pixel X,Y (column from the left, row from the top).
     #[arg(long, value_parser = probe::parse_pixel)]
     pub probe: Option<(u32, u32)>,
-    /// Present a tour from its first step: `--tour=FILE`, or the bundled lecture with `--tour` alone.
-    #[arg(long, num_args = 0..=1, require_equals = true, default_missing_value = "lecture", value_name = "FILE")]
+    /// Present a tour from its first step: a tour file, or the bundled lecture without one (a scene to start on
+    /// goes before `--tour`).
+    #[arg(long, num_args = 0..=1, default_missing_value = "lecture", value_name = "FILE")]
     pub tour: Option<String>,
 }
 
@@ -264,6 +265,12 @@ pub fn run(command: Command) -> Result<()> {
         Command::View(args) if !args.exposure.is_finite() => bail!("--exposure must be a finite number of stops"),
         Command::View(args) => {
             // A bad tour is one line and a non-zero exit, before any window opens.
+            if let Some(t) = args.tour.as_deref()
+                && illumlab::scene::BUNDLED_SCENES.iter().any(|b| b.name == t)
+                && !std::path::Path::new(t).exists()
+            {
+                bail!("`{t}` is a scene, not a tour: put it before --tour (illumlab view {t} --tour)");
+            }
             let tour = args.tour.as_deref().map(illumlab::tour::Tour::load).transpose()?;
             illumlab::app::run(illumlab::app::ViewOptions {
                 scene: args.scene.unwrap_or_else(|| illumlab::scene::DEFAULT_SCENE.into()),

@@ -139,12 +139,7 @@ pub fn estimate_light_lanes(
 ) -> [Vec3; LANES] {
     let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    // Per lane, the shadow ray's ends: the shading point and its normal, the point on the light and its normal,
-    // and their bounds.
-    let mut ends = [[Vec3::ZERO; LANES]; 4];
-    let (mut p_error, mut light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
-    let mut groups = [SKIP_NONE; LANES];
-    let mut shadow_rays = 0;
+    let mut shadow_rays = ShadowRays::default();
     for l in 0..LANES {
         let Some(hit) = hits.lane(l) else { continue };
         let tri = &scene.triangles[hit.triangle as usize];
@@ -155,15 +150,47 @@ pub fn estimate_light_lanes(
         let Target::Emitter { triangle, point } = s.target else { continue };
         let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
         reflected[l] = value / s.pdf;
-        (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
-        (p_error[l], light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
-        groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
-        shadow_rays |= 1 << l;
+        shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
     }
-    let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
-    let near = (p, n, f32x8::new(p_error));
-    let visible = visible_lanes(scene, near, (x, n_x), (&light_error, groups), shadow_rays, rays);
+    let visible = shadow_rays.trace(scene, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+}
+
+/// The shadow rays of a group's lanes, gathered lane by lane and traced together ([`visible_lanes`]).
+struct ShadowRays {
+    /// Per lane: the shading point and its normal, the point on the light and its normal.
+    ends: [[Vec3; LANES]; 4],
+    p_error: [f32; LANES],
+    light_error: [SurfaceError; LANES],
+    groups: [u32; LANES],
+    /// The lanes with a ray.
+    lanes: u32,
+}
+
+impl Default for ShadowRays {
+    fn default() -> Self {
+        let (p_error, light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
+        Self { ends: [[Vec3::ZERO; LANES]; 4], p_error, light_error, groups: [SKIP_NONE; LANES], lanes: 0 }
+    }
+}
+
+impl ShadowRays {
+    /// Lane `l`'s ray from `sp` to `point` (normal `n_x`) on emitter triangle `triangle`.
+    #[inline(always)]
+    fn add(&mut self, l: usize, scene: &Scene, sp: &ShadingPoint, (triangle, point, n_x): (u32, Vec3, Vec3)) {
+        (self.ends[0][l], self.ends[1][l], self.ends[2][l], self.ends[3][l]) = (sp.p, sp.n, point, n_x);
+        (self.p_error[l], self.light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
+        self.groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
+        self.lanes |= 1 << l;
+    }
+
+    /// The lanes whose ray gets through; adds the rays traced to `rays`.
+    #[inline(always)]
+    fn trace(&self, scene: &Scene, rays: &mut u64) -> u32 {
+        let [p, n, x, n_x] = self.ends.map(|e| Vec3x8::from_lanes(&e));
+        let near = (p, n, f32x8::new(self.p_error));
+        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, rays)
+    }
 }
 
 /// Veach's multi-sample MIS with one direction from a light technique and one from a BRDF technique
@@ -189,13 +216,9 @@ pub fn estimate_mis_lanes(
     let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
     let heuristic = ctx.mis.heuristic;
     let mut emitted = [Vec3::ZERO; LANES];
-    // Each lane's first direction's contribution, weighted (if its shadow ray, in `shadow_rays`, gets through),
-    // and the shadow ray's ends.
+    // Each lane's first direction's contribution, weighted (if its shadow ray, if it has one, gets through).
     let mut first = [Vec3::ZERO; LANES];
-    let mut ends = [[Vec3::ZERO; LANES]; 4];
-    let (mut p_error, mut light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
-    let mut groups = [SKIP_NONE; LANES];
-    let mut shadow_rays = 0;
+    let mut shadow_rays = ShadowRays::default();
     let mut shading = [None; LANES];
     for l in 0..LANES {
         let Some(hit) = hits.lane(l) else { continue };
@@ -216,10 +239,7 @@ pub fn estimate_mis_lanes(
                 let p_other = brdf.pdf(&contexts[1], &sp, s.wi, Some(Reached { triangle, point }));
                 let w = heuristic.weight(1, s.pdf, 1, p_other);
                 first[l] = value * (w / (1.0 * s.pdf));
-                (ends[0][l], ends[1][l], ends[2][l], ends[3][l]) = (sp.p, sp.n, point, n_x);
-                (p_error[l], light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
-                groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
-                shadow_rays |= 1 << l;
+                shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
             }
         }
         shading[l] = Some(sp);
@@ -235,11 +255,9 @@ pub fn estimate_mis_lanes(
             from_brdf[l] = value * (w / (1.0 * s.pdf));
         }
     }
-    let [p, n, x, n_x] = ends.map(|e| Vec3x8::from_lanes(&e));
-    let near = (p, n, f32x8::new(p_error));
-    let visible = visible_lanes(scene, near, (x, n_x), (&light_error, groups), shadow_rays, rays);
+    let visible = shadow_rays.trace(scene, rays);
     std::array::from_fn(|l| {
-        let shadowed = shadow_rays & !visible & (1 << l) != 0;
+        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
         let mut total = Vec3::ZERO;
         total += if shadowed { Vec3::ZERO } else { first[l] };
         total += from_brdf[l];
