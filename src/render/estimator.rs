@@ -92,7 +92,7 @@ pub fn reached(scene: &Scene, sp: &ShadingPoint, wi: Vec3) -> Option<Reached> {
 /// f_r and ω·n for a sampled direction; why not, where the sample contributes nothing whatever arrives along ω
 /// (below the surface, zero density, f_r = 0).
 #[inline]
-fn brdf_and_cos(sp: &ShadingPoint, s: &DirectionSample) -> Result<(Vec3, f32), Outcome> {
+pub(super) fn brdf_and_cos(sp: &ShadingPoint, s: &DirectionSample) -> Result<(Vec3, f32), Outcome> {
     let cos = sp.n.dot(s.wi);
     if !(cos > 0.0 && s.pdf > 0.0) {
         return Err(if cos > 0.0 { Outcome::NoSample } else { Outcome::BelowSurface });

@@ -7,7 +7,7 @@
 //! bit, so a film does not depend on how its samples were grouped.
 
 use super::estimator::{unshadowed, visible_lanes};
-use super::strategy::{SampleContext, Technique};
+use super::strategy::{DirectionSample, SampleContext, Technique};
 use super::{ShadingPoint, Target};
 use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
@@ -244,16 +244,23 @@ pub fn estimate_mis_lanes(
         }
         shading[l] = Some(sp);
     }
-    // The BRDF directions, each drawn after its lane's light direction, traced one by one.
+    // The BRDF directions, each drawn after its lane's light direction; those to trace walk the tree together.
     let mut from_brdf = [Vec3::ZERO; LANES];
+    let mut traced = TracedRays::default();
     for l in 0..LANES {
         let Some(sp) = &shading[l] else { continue };
         let Some(s) = brdf.sample(&contexts[1], sp, &mut rngs[l]) else { continue };
-        if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
-            let p_other = light.pdf(&contexts[0], sp, s.wi, Some(via));
-            let w = heuristic.weight(1, s.pdf, 1, p_other);
+        if let Target::Trace = s.target {
+            traced.add(l, sp, s, rays);
+        } else if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
+            let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
             from_brdf[l] = value * (w / (1.0 * s.pdf));
         }
+    }
+    for (l, found) in traced.trace(scene).into_iter().enumerate() {
+        let (Some(sp), Some((value, via, s))) = (&shading[l], found) else { continue };
+        let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
+        from_brdf[l] = value * (w / (1.0 * s.pdf));
     }
     let visible = shadow_rays.trace(scene, rays);
     std::array::from_fn(|l| {
@@ -263,4 +270,81 @@ pub fn estimate_mis_lanes(
         total += from_brdf[l];
         emitted[l] + total
     })
+}
+
+/// The one-sample estimator `f_r L_i (ω·n) / p(ω)` of a strategy that traces its directions (uniform, cosine,
+/// BRDF sampling) for up to eight samples of one pixel: per lane the direction is drawn as
+/// [`super::estimator::one_sample`] draws it, then the lanes' rays walk the tree together, interleaved
+/// ([`TracedRays`]); a direction aimed at a light is looked up alone. The same values bit for bit. Adds the rays
+/// traced to `rays`.
+#[inline]
+pub fn estimate_traced_lanes(
+    ctx: &SampleContext,
+    strategy: &impl Technique,
+    dirs: &Vec3x8,
+    hits: &HitLanes,
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    let scene = ctx.scene;
+    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let mut traced = TracedRays::default();
+    for l in 0..LANES {
+        let Some(hit) = hits.lane(l) else { continue };
+        let tri = &scene.triangles[hit.triangle as usize];
+        let wo = -dirs.lane(l);
+        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
+        emitted[l] = scene.emitted(hit.triangle, wo);
+        let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
+        if let Target::Trace = s.target {
+            traced.add(l, &sp, s, rays);
+        } else if let Ok((value, _)) = super::estimator::integrand(scene, &sp, &s, rays) {
+            reflected[l] = value / s.pdf;
+        }
+    }
+    for (l, found) in traced.trace(scene).into_iter().enumerate() {
+        if let Some((value, _, s)) = found {
+            reflected[l] = value / s.pdf;
+        }
+    }
+    std::array::from_fn(|l| emitted[l] + reflected[l])
+}
+
+/// Sampled directions to trace, gathered lane by lane (`integrand`'s first half: f_r and ω·n, the ray's origin off
+/// the surface) and traced together (`Accel::closest_hits`), then looked up as `integrand` looks them up.
+#[derive(Default)]
+struct TracedRays {
+    rays: [(Vec3, Vec3); LANES],
+    /// Per lane: the direction, f_r and ω·n.
+    pending: [Option<(DirectionSample, Vec3, f32)>; LANES],
+    lanes: u32,
+}
+
+impl TracedRays {
+    /// Lane `l`'s direction `s` from `sp`, unless it contributes nothing whatever arrives along it (then no ray is
+    /// traced, as in `integrand`).
+    #[inline(always)]
+    fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) {
+        let Ok((f, cos)) = super::estimator::brdf_and_cos(sp, &s) else { return };
+        *rays += 1;
+        self.rays[l] = (crate::math::offset_ray_origin(sp.p, sp.n, sp.error), s.wi);
+        self.pending[l] = Some((s, f, cos));
+        self.lanes |= 1 << l;
+    }
+
+    /// Per lane: `f_r L_e (ω·n)` where the ray meets a surface that emits towards it, the emitter triangle and point
+    /// it reached, and the direction.
+    #[inline(always)]
+    fn trace(&self, scene: &Scene) -> [Option<(Vec3, super::strategy::Reached, DirectionSample)>; LANES] {
+        let found = scene.accel().closest_hits(&self.rays, self.lanes, f32::INFINITY);
+        std::array::from_fn(|l| {
+            let ((s, f, cos), hit) = (self.pending[l]?, found[l]?);
+            let li = scene.emitted(hit.triangle, -s.wi);
+            if li == Vec3::ZERO {
+                return None;
+            }
+            let via = super::strategy::Reached { triangle: hit.triangle, point: scene.hit_point(&hit) };
+            Some((f * li * cos, via, s))
+        })
+    }
 }

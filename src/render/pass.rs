@@ -2,7 +2,7 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
-use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes, estimate_mis_lanes};
+use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes, estimate_mis_lanes, estimate_traced_lanes};
 use super::sink::{Census, Learner};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
@@ -375,6 +375,12 @@ impl Renderer {
                     }
                     _ => estimate_light_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
                 }
+            }
+            // The hemisphere strategies: their rays walk the tree together.
+            (Strategy::Uniform | Strategy::Cosine | Strategy::Brdf, _) if learned.is_none() => {
+                let mut rngs = std::array::from_fn(|l| rngs.lane(l));
+                let ctx = self.context();
+                estimate_traced_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)

@@ -283,6 +283,42 @@ mod tests {
         assert!(occluded > 2000, "only {occluded} rays occluded: the test checks too little");
     }
 
+    /// Eight closest-hit walks interleaved (`Accel::closest_hits`) find what each finds alone, bit for bit, with
+    /// some lanes inactive: coherent and unrelated bundles, on soups of every size and on coincident triangles
+    /// (ties broken as alone).
+    #[test]
+    fn eight_closest_hit_walks_interleaved_answer_as_each_alone() {
+        let mut hit = 0;
+        let mut soups: Vec<Vec<[Vec3; 3]>> =
+            [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)].map(|(n, size)| random_soup(n, size, 70 + n as u64)).into();
+        soups.push(vec![[Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, -5.0, 0.0), Vec3::new(0.0, 5.0, 0.0)]; 300]);
+        for (k, tris) in soups.iter().enumerate() {
+            let (accel, _) = Accel::build(tris, &vec![None; tris.len()]);
+            for group in 0..1000u64 {
+                let mut rng = SampleRng::new(23, group, k as u64);
+                let mut point =
+                    |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
+                let (centre, target) = (point(16.0), point(4.0));
+                let coherent = group % 2 == 0;
+                let rays: [(Vec3, Vec3); 8] = std::array::from_fn(|_| {
+                    let o = if coherent { centre + point(0.5) } else { point(16.0) };
+                    (o, if coherent { target + point(2.0) - o } else { point(16.0) - o })
+                });
+                let active = (group as u32).wrapping_mul(0x9e37_79b9) >> 24 | 1;
+                let t_max = [f32::INFINITY, 0.5][group as usize % 2];
+                let together = accel.closest_hits(&rays, active, t_max);
+                for l in 0..8 {
+                    let alone =
+                        (active & (1 << l) != 0).then(|| accel.closest_hit(rays[l].0, rays[l].1, t_max)).flatten();
+                    let key = |h: Option<Hit>| h.map(|h| (h.triangle, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()));
+                    assert_eq!(key(together[l]), key(alone), "soup {k}, group {group}, lane {l}");
+                    hit += alone.is_some() as u32;
+                }
+            }
+        }
+        assert!(hit > 4000, "only {hit} rays hit: the test checks too little");
+    }
+
     #[test]
     fn agrees_on_coincident_and_needle_triangles() {
         // Thousands of identical triangles (a deep, degenerate tree: the depth limit makes one large leaf) and

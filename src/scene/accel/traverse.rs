@@ -41,27 +41,9 @@ impl Accel {
                 }
             } else {
                 let node = &self.nodes[current.first as usize];
-                let (mut mask, t_enter) = node.intersect(&ray, best_t);
+                let (mask, t_enter) = node.intersect(&ray, best_t);
                 if mask != 0 {
-                    let t_enter = t_enter.to_array();
-                    // Sort the entered children by distance, nearest first (insertion sort: at most eight).
-                    let mut order = [(0.0f32, 0usize); 8];
-                    let mut n = 0;
-                    while mask != 0 {
-                        let lane = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
-                        let mut k = n;
-                        while k > 0 && order[k - 1].0 > t_enter[lane] {
-                            order[k] = order[k - 1];
-                            k -= 1;
-                        }
-                        order[k] = (t_enter[lane], lane);
-                        n += 1;
-                    }
-                    for &(t, lane) in order[1..n].iter().rev() {
-                        stack.push((node.children[lane], t));
-                    }
-                    current = node.children[order[0].1];
+                    current = enter_nearest(node, mask, t_enter.to_array(), &mut stack);
                     continue;
                 }
             }
@@ -72,6 +54,61 @@ impl Accel {
                     current = child;
                     break;
                 }
+            }
+        }
+    }
+
+    /// [`Accel::closest_hit`] for up to eight rays, one per lane of `active` (bit l for `rays[l]`), each walking
+    /// the tree alone but interleaved with the others, one step of each in turn: their dependent chains (load a
+    /// node, test its boxes, take a child) overlap instead of waiting on one another. Each ray takes the steps it
+    /// takes alone, so its hit is [`Accel::closest_hit`]'s, bit for bit.
+    #[inline]
+    pub fn closest_hits(&self, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> [Option<Hit>; 8] {
+        let Some(root) = self.root else { return [None; 8] };
+        let mut walks: [Option<ClosestHitWalk>; 8] = Default::default();
+        for_each_lane(active, |l| walks[l] = Some(ClosestHitWalk::new(root, rays[l].0, rays[l].1, t_max)));
+        let mut walking = active;
+        while walking != 0 {
+            for_each_lane(walking, |l| {
+                if let Some(walk) = &mut walks[l]
+                    && !self.closest_hit_step(walk)
+                {
+                    walking &= !(1 << l);
+                }
+            });
+        }
+        walks.map(|w| w.and_then(|w| w.best))
+    }
+
+    /// One step of a closest-hit walk: tests the current leaf's triangles, or enters the current node's nearest
+    /// child entered (the others pending, nearest on top); after a leaf or a node no child of which is entered,
+    /// takes the nearest pending child that may still hold something nearer than the best hit. False when none is
+    /// left: the walk is over.
+    #[inline(always)]
+    fn closest_hit_step(&self, walk: &mut ClosestHitWalk) -> bool {
+        let current = walk.current;
+        if current.is_leaf() {
+            for p in current.first..current.first + current.packets {
+                let packet = &self.packets[p as usize];
+                if let Some(h) = packet.closest(&walk.ray, walk.best_t) {
+                    walk.best_t = h.t;
+                    walk.best = Some(Hit { triangle: packet.ids[h.lane], t: h.t, u: h.u, v: h.v });
+                }
+            }
+        } else {
+            let node = &self.nodes[current.first as usize];
+            let (mask, t_enter) = node.intersect(&walk.ray, walk.best_t);
+            if mask != 0 {
+                walk.current = enter_nearest(node, mask, t_enter.to_array(), &mut walk.stack);
+                return true;
+            }
+        }
+        // Next: the nearest pending child that may still hold something nearer than the best hit.
+        loop {
+            let Some((child, t_enter)) = walk.stack.pop() else { return false };
+            if t_enter < walk.best_t {
+                walk.current = child;
+                return true;
             }
         }
     }
@@ -261,6 +298,51 @@ impl Accel {
             });
         }
         occluded
+    }
+}
+
+/// The child of `node` to enter next among those the ray enters (`mask`, at distances `t_enter`): the nearest;
+/// the others are pushed on `stack`, the nearest on top (an insertion sort: at most eight).
+#[inline(always)]
+fn enter_nearest(
+    node: &super::node::Node8,
+    mut mask: u32,
+    t_enter: [f32; 8],
+    stack: &mut ArrayVec<(Child, f32), STACK>,
+) -> Child {
+    let mut order = [(0.0f32, 0usize); 8];
+    let mut n = 0;
+    while mask != 0 {
+        let lane = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let mut k = n;
+        while k > 0 && order[k - 1].0 > t_enter[lane] {
+            order[k] = order[k - 1];
+            k -= 1;
+        }
+        order[k] = (t_enter[lane], lane);
+        n += 1;
+    }
+    for &(t, lane) in order[1..n].iter().rev() {
+        stack.push((node.children[lane], t));
+    }
+    node.children[order[0].1]
+}
+
+/// Where a closest-hit walk stands: the subtree it is in, the children pending (with the distance at which the ray
+/// enters them), and the best hit so far.
+struct ClosestHitWalk {
+    ray: WideRay,
+    current: Child,
+    stack: ArrayVec<(Child, f32), STACK>,
+    best_t: f32,
+    best: Option<Hit>,
+}
+
+impl ClosestHitWalk {
+    #[inline(always)]
+    fn new(root: Child, origin: Vec3, dir: Vec3, t_max: f32) -> Self {
+        Self { ray: WideRay::new(origin, dir), current: root, stack: ArrayVec::new(), best_t: t_max, best: None }
     }
 }
 
