@@ -341,3 +341,17 @@ fn an_error_when_applying_names_the_step_that_set_the_field() {
     let e = p.go(2, &mut s).unwrap_err().to_string();
     assert!(e.contains("step 3 (\"Three\"), field `material`") && e.contains("marble"), "{e}");
 }
+
+/// The tour examples in the README and in docs/tours.md parse, and apply to a session.
+#[test]
+fn the_documented_examples_are_valid_tours() {
+    for doc in ["README.md", "docs/tours.md"] {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/").to_string() + doc).unwrap();
+        let start = text.find("```toml").unwrap_or_else(|| panic!("{doc} has no TOML example")) + "```toml".len();
+        let end = start + text[start..].find("```").unwrap();
+        let example: String = text[start..end].lines().map(|l| l.trim_start().to_string() + "\n").collect();
+        let tour = parse_tour(&example, doc).unwrap_or_else(|e| panic!("{e}"));
+        let mut s = session("cornell-box");
+        Presenter::start(tour, &mut s).unwrap_or_else(|e| panic!("{e}"));
+    }
+}

@@ -141,11 +141,8 @@ pub fn estimate_light_lanes(
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let mut shadow_rays = ShadowRays::default();
     for l in 0..LANES {
-        let Some(hit) = hits.lane(l) else { continue };
-        let tri = &scene.triangles[hit.triangle as usize];
-        let wo = -dirs.lane(l);
-        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
-        emitted[l] = scene.emitted(hit.triangle, wo);
+        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
+        emitted[l] = le;
         let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
         let Target::Emitter { triangle, point } = s.target else { continue };
         let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
@@ -154,6 +151,17 @@ pub fn estimate_light_lanes(
     }
     let visible = shadow_rays.trace(scene, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+}
+
+/// Lane `l`'s shading point (where its camera ray along `dirs` hit, if it did) and the radiance it emits
+/// towards the camera, as the one-sample estimator sets them up.
+#[inline(always)]
+fn shading_point<'a>(scene: &'a Scene, dirs: &Vec3x8, hits: &HitLanes, l: usize) -> Option<(ShadingPoint<'a>, Vec3)> {
+    let hit = hits.lane(l)?;
+    let tri = &scene.triangles[hit.triangle as usize];
+    let wo = -dirs.lane(l);
+    let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
+    Some((sp, scene.emitted(hit.triangle, wo)))
 }
 
 /// The shadow rays of a group's lanes, gathered lane by lane and traced together ([`visible_lanes`]).
@@ -221,11 +229,8 @@ pub fn estimate_mis_lanes(
     let mut shadow_rays = ShadowRays::default();
     let mut shading = [None; LANES];
     for l in 0..LANES {
-        let Some(hit) = hits.lane(l) else { continue };
-        let tri = &scene.triangles[hit.triangle as usize];
-        let wo = -dirs.lane(l);
-        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
-        emitted[l] = scene.emitted(hit.triangle, wo);
+        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
+        emitted[l] = le;
         if let Some(s) = light.sample(&contexts[0], &sp, &mut rngs[l]) {
             let Target::Emitter { triangle, point } = s.target else {
                 if let Ok((value, via)) = integrand(scene, &sp, &s, rays) {
@@ -290,11 +295,8 @@ pub fn estimate_traced_lanes(
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let mut traced = TracedRays::default();
     for l in 0..LANES {
-        let Some(hit) = hits.lane(l) else { continue };
-        let tri = &scene.triangles[hit.triangle as usize];
-        let wo = -dirs.lane(l);
-        let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
-        emitted[l] = scene.emitted(hit.triangle, wo);
+        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
+        emitted[l] = le;
         let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
         if let Target::Trace = s.target {
             traced.add(l, &sp, s, rays);
