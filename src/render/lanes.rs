@@ -205,9 +205,9 @@ impl ShadowRays {
 /// (`MisSettings::samples` = [1, 1]) for up to eight samples of one pixel: what [`super::strategy::mis`]'s estimator
 /// gives each sample, bit for bit. Per lane, the light technique draws first and the BRDF technique second from
 /// the sample's own stream, as there; each weight needs only the two densities, so it is computed before the
-/// rays are traced. The light directions' shadow rays then go together ([`visible_lanes`]); the BRDF directions
-/// are traced one after the other (as is a first technique's direction that is not aimed at a light). Adds the
-/// rays traced to `rays`.
+/// rays are traced. The light directions' shadow rays then go together ([`visible_lanes`]) and the BRDF directions
+/// walk the tree together, interleaved ([`TracedRays`]); a first technique's direction that is not aimed at a
+/// light, or a second technique's that is, is looked up alone. Adds the rays traced to `rays`.
 #[inline]
 pub fn estimate_mis_lanes(
     ctx: &SampleContext,
