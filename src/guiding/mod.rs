@@ -24,7 +24,7 @@ mod training;
 pub use dtree::{DTree, Sums, dir_to_square, square_to_dir};
 pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
 pub use shape::Shape;
-pub use stree::STree;
+pub use stree::{LeafHint, STree};
 pub use training::{GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
 
 use glam::Vec3;
@@ -63,6 +63,13 @@ impl Guide {
     #[inline]
     pub fn leaf(&self, p: Vec3) -> (&DTree, [f32; 3]) {
         let leaf = self.stree.leaf(p) as usize;
+        (&self.dtrees[leaf], self.weights[leaf])
+    }
+
+    /// [`Guide::leaf`] through a hint (see [`STree::leaf_near`]): the same leaf.
+    #[inline]
+    pub fn leaf_near(&self, p: Vec3, hint: &mut Option<LeafHint>) -> (&DTree, [f32; 3]) {
+        let leaf = self.stree.leaf_near(p, hint) as usize;
         (&self.dtrees[leaf], self.weights[leaf])
     }
 

@@ -23,6 +23,14 @@ pub struct STree {
     leaves: usize,
 }
 
+/// A leaf and its box, in the tree's unit cube (see [`STree::leaf_near`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LeafHint {
+    leaf: u32,
+    lo: Vec3,
+    hi: Vec3,
+}
+
 impl STree {
     /// One leaf over the cube around the box `lo..hi` (enlarged by 1% so that points on its faces are inside).
     pub fn new(lo: Vec3, hi: Vec3) -> Self {
@@ -57,6 +65,39 @@ impl STree {
                     let upper = x[axis] >= 0.5;
                     x[axis] = if upper { x[axis] * 2.0 - 1.0 } else { x[axis] * 2.0 };
                     size[axis] *= 0.5;
+                    node = children[upper as usize] as usize;
+                    axis = (axis + 1) % 3;
+                }
+            }
+        }
+    }
+
+    /// [`STree::leaf`], remembering the leaf's box in `hint`: a point in the box of the hint's leaf is in that
+    /// leaf, found without a descent (the samples of one pixel mostly share a leaf). The descent halves `x` at
+    /// dyadic thresholds, exactly, so the box test gives the descent's answer bit for bit.
+    #[inline]
+    pub fn leaf_near(&self, p: Vec3, hint: &mut Option<LeafHint>) -> u32 {
+        let x = ((p - self.origin) / self.side).clamp(Vec3::ZERO, Vec3::splat(1.0 - f32::EPSILON));
+        if let Some(h) = hint
+            && x.cmpge(h.lo).all()
+            && x.cmplt(h.hi).all()
+        {
+            return h.leaf;
+        }
+        let (mut node, mut axis) = (0usize, 0usize);
+        let (mut lo, mut size) = (Vec3::ZERO, Vec3::ONE);
+        loop {
+            match self.nodes[node] {
+                SNode::Leaf(leaf) => {
+                    *hint = Some(LeafHint { leaf, lo, hi: lo + size });
+                    return leaf;
+                }
+                SNode::Inner(children) => {
+                    size[axis] *= 0.5;
+                    let upper = x[axis] >= lo[axis] + size[axis];
+                    if upper {
+                        lo[axis] += size[axis];
+                    }
                     node = children[upper as usize] as usize;
                     axis = (axis + 1) % 3;
                 }
@@ -156,6 +197,41 @@ mod tests {
         assert_eq!(tree.leaves(), 19);
         assert_eq!(parents.iter().filter(|&&p| p == 3).count(), 4);
         assert!(parents.windows(2).all(|w| w[0] <= w[1]), "new leaves keep the old leaves' order");
+    }
+
+    /// A hint gives the leaf a descent gives, for points inside, on and beyond its box's faces, after splits
+    /// that leave leaves of many depths (down to 2⁻¹⁵ of the side on an axis).
+    #[test]
+    fn a_hinted_lookup_finds_the_leaf_a_descent_finds() {
+        let mut tree = STree::new(Vec3::new(-3.0, 0.5, 2.0), Vec3::new(4.0, 1.0, 3.0));
+        for round in 0..6u64 {
+            let counts: Vec<u64> = (0..tree.leaves() as u64).map(|l| (l * 7919 + round * 104_729) % 5000).collect();
+            tree.split(&counts, 400.0, 46);
+        }
+        assert!(tree.leaves() > 500, "{} leaves: the test checks too little", tree.leaves());
+        let (lo, side) = (tree.origin, tree.side);
+        let mut hint = None;
+        let mut rng = crate::math::SampleRng::new(3, 1, 4);
+        let mut reused = 0;
+        let mut centre = lo;
+        for i in 0..200_000 {
+            // Clusters of eight nearby points (as a pixel's samples), some reaching outside the cube, and dyadic
+            // grid points (on the faces of boxes).
+            let mut unit = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+            if i % 8 == 0 {
+                centre = lo + Vec3::splat(side) * (unit() * 1.2 - 0.1);
+            }
+            let p = if i % 8 == 7 {
+                lo + Vec3::splat(side) * ((unit() * 64.0).floor() / 64.0)
+            } else {
+                centre + unit() * 1e-3
+            };
+            let had = hint.map(|h: LeafHint| h.leaf);
+            let near = tree.leaf_near(p, &mut hint);
+            assert_eq!(near, tree.leaf(p), "point {p}");
+            reused += (had == Some(near)) as u32;
+        }
+        assert!(reused > 10_000, "the hint was used only {reused} times");
     }
 
     #[test]

@@ -350,3 +350,51 @@ impl TracedRays {
         })
     }
 }
+
+/// [`super::strategy::guided`]'s estimator with a frozen guide for up to eight samples of one pixel, bit for bit:
+/// per lane a direction of the mixture; the directions aimed at a light have their shadow rays traced together,
+/// the others walk the tree together, interleaved; then each value is divided by the mixture's density at its
+/// direction, given the emitter it reached. Adds the rays traced to `rays`.
+#[inline]
+pub fn estimate_guided_lanes(
+    ctx: &SampleContext,
+    dirs: &Vec3x8,
+    hits: &HitLanes,
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    use super::strategy::Reached;
+    use super::strategy::guided::Drawn;
+    let scene = ctx.scene;
+    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let (mut shadow_rays, mut traced) = (ShadowRays::default(), TracedRays::default());
+    let mut pending: [Option<(ShadingPoint, Drawn)>; LANES] = std::array::from_fn(|_| None);
+    let mut leaf = None;
+    for l in 0..LANES {
+        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
+        emitted[l] = le;
+        let Some(d) = Drawn::draw(ctx, &sp, &mut rngs[l], &mut leaf) else { continue };
+        match d.s.target {
+            Target::Emitter { triangle, point } => {
+                if let Ok((value, n_x)) = unshadowed(scene, &sp, &d.s, triangle) {
+                    reflected[l] = d.weighted(ctx, &sp, value, Reached { triangle, point });
+                    shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
+                }
+            }
+            Target::Trace => {
+                traced.add(l, &sp, d.s, rays);
+                pending[l] = Some((sp, d));
+            }
+        }
+    }
+    let visible = shadow_rays.trace(scene, rays);
+    for (l, found) in traced.trace(scene).into_iter().enumerate() {
+        if let (Some((sp, d)), Some((value, via, _))) = (&pending[l], found) {
+            reflected[l] = d.weighted(ctx, sp, value, via);
+        }
+    }
+    std::array::from_fn(|l| {
+        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
+        emitted[l] + if shadowed { Vec3::ZERO } else { reflected[l] }
+    })
+}

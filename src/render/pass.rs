@@ -2,7 +2,10 @@
 //! seeded stream, rows in parallel (rayon). Per-pixel order is fixed, so the film is the same bit for bit with any
 //! number of threads and any split into passes.
 
-use super::lanes::{LANES, estimate_emitter_lanes, estimate_light_lanes, estimate_mis_lanes, estimate_traced_lanes};
+use super::lanes::{
+    LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_light_lanes, estimate_mis_lanes,
+    estimate_traced_lanes,
+};
 use super::sink::{Census, Learner};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
@@ -382,6 +385,11 @@ impl Renderer {
                 let ctx = self.context();
                 estimate_traced_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
             }
+            // `guided` with its guide frozen (training passes record every direction one sample at a time).
+            (Strategy::Guided, _) if learned.is_none() => {
+                let mut rngs = std::array::from_fn(|l| rngs.lane(l));
+                estimate_guided_lanes(&self.context(), &dirs, &hits, &mut rngs, rays)
+            }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)
                 if learned.is_none() && self.settings.mis.is_valid() && self.settings.mis.samples == [1, 1] =>
@@ -515,6 +523,12 @@ mod tests {
                     ..Default::default()
                 }),
             )
+            // A guide frozen after 3 spp: the rest of the passes take the eight-lane estimator.
+            .chain(std::iter::once(RenderSettings {
+                strategy: Strategy::Guided,
+                guiding: GuideSettings { training_spp: 3, ..Default::default() },
+                ..Default::default()
+            }))
             .collect();
         for (name, scene, camera) in every_bundled_scene(48, 36) {
             let scene = Arc::new(scene);

@@ -15,7 +15,7 @@
 use super::brdf::Brdf;
 use super::emitter::Emitter;
 use super::{DirectionSample, DirectionStrategy, Domain, Reached, SampleContext, Target, Technique};
-use crate::guiding::{DEFAULT_WEIGHTS, DTree};
+use crate::guiding::{DEFAULT_WEIGHTS, DTree, LeafHint};
 use crate::math::SampleRng;
 use crate::render::ShadingPoint;
 use crate::render::estimator::{integrand, reached};
@@ -34,6 +34,7 @@ pub fn weights(ctx: &SampleContext, sp: &ShadingPoint) -> [f32; 3] {
 
 /// The mixture at one shading point: its spatial leaf's quadtree (where a guide exists) and its weights, looked up
 /// once per sample.
+#[derive(Clone, Copy)]
 struct Mixture<'a> {
     dtree: Option<&'a DTree>,
     w: [f32; 3],
@@ -42,9 +43,15 @@ struct Mixture<'a> {
 impl<'a> Mixture<'a> {
     #[inline]
     fn at(ctx: &SampleContext<'a>, sp: &ShadingPoint) -> Self {
+        Self::at_near(ctx, sp, &mut None)
+    }
+
+    /// [`Mixture::at`], its spatial leaf found through `hint` (the same leaf: see `STree::leaf_near`).
+    #[inline]
+    fn at_near(ctx: &SampleContext<'a>, sp: &ShadingPoint, hint: &mut Option<LeafHint>) -> Self {
         let (dtree, [g, l, b]) = match ctx.guide {
             Some(guide) => {
-                let (dtree, w) = guide.leaf(sp.p);
+                let (dtree, w) = guide.leaf_near(sp.p, hint);
                 (Some(dtree), w)
             }
             None => (None, DEFAULT_WEIGHTS),
@@ -91,8 +98,9 @@ impl Guided {
         ctx: &SampleContext<'a>,
         sp: &ShadingPoint,
         rng: &mut SampleRng,
+        hint: &mut Option<LeafHint>,
     ) -> Option<(DirectionSample, Mixture<'a>)> {
-        let m = Mixture::at(ctx, sp);
+        let m = Mixture::at_near(ctx, sp, hint);
         let s = match choose(&m.w, rng.uniform()) {
             0 => {
                 let (wi, pdf) = m.dtree?.sample(rng)?;
@@ -102,6 +110,35 @@ impl Guided {
             _ => Technique::sample(&Brdf, ctx, sp, rng)?,
         };
         Some((s, m))
+    }
+}
+
+/// A direction drawn as [`Guided`]'s estimator draws it, for the eight-lane estimator
+/// (`render::lanes::estimate_guided_lanes`), which traces the lanes' rays together and then weighs each value.
+#[derive(Clone, Copy)]
+pub(crate) struct Drawn<'a> {
+    pub s: DirectionSample,
+    m: Mixture<'a>,
+}
+
+impl<'a> Drawn<'a> {
+    /// A direction of the mixture at `sp`, drawn from `rng` as the estimator draws it; its spatial leaf is found
+    /// through `hint` (the samples of a pixel mostly share one).
+    #[inline(always)]
+    pub(crate) fn draw(
+        ctx: &SampleContext<'a>,
+        sp: &ShadingPoint,
+        rng: &mut SampleRng,
+        hint: &mut Option<LeafHint>,
+    ) -> Option<Self> {
+        Guided::sample_part(ctx, sp, rng, hint).map(|(s, m)| Self { s, m })
+    }
+
+    /// `f_r L_i (ω·n)` over the mixture's density at ω, given the emitter triangle and point ω reached: the
+    /// estimator's contribution.
+    #[inline(always)]
+    pub(crate) fn weighted(&self, ctx: &SampleContext, sp: &ShadingPoint, value: Vec3, via: Reached) -> Vec3 {
+        value / self.m.pdf(&self.m.parts(ctx, sp, self.s.wi, Some(via)))
     }
 }
 
@@ -116,7 +153,7 @@ impl DirectionStrategy for Guided {
     /// A direction of the mixture with the mixture's density (which, for a direction the guide or the BRDF
     /// drew, needs the emitter triangle it reaches: one more ray).
     fn sample(&self, ctx: &SampleContext, sp: &ShadingPoint, rng: &mut SampleRng) -> Option<DirectionSample> {
-        let (s, m) = Self::sample_part(ctx, sp, rng)?;
+        let (s, m) = Self::sample_part(ctx, sp, rng, &mut None)?;
         let via = match s.target {
             Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
             Target::Trace => reached(ctx.scene, sp, s.wi),
@@ -141,7 +178,7 @@ impl DirectionStrategy for Guided {
         rays: &mut u64,
         sink: &mut S,
     ) -> Vec3 {
-        let Some((s, m)) = Self::sample_part(ctx, sp, rng) else {
+        let Some((s, m)) = Self::sample_part(ctx, sp, rng, &mut None) else {
             sink.record(SampleRecord::none(0));
             return Vec3::ZERO;
         };
