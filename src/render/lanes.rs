@@ -125,11 +125,14 @@ pub fn estimate_emitter_lanes(
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
 
-/// [`estimate_emitter_lanes`] for any light strategy, with the sampling and the BRDF lane by lane: only the
-/// shadow rays go together. Each lane's stream `rngs[l]` continues after the camera's two uniforms. Adds the
-/// shadow rays traced to `rays`.
+/// The one-sample estimator `f_r L_i (ω·n) / p(ω)` of any strategy that draws one direction (the light
+/// strategies but `emitter`'s own SIMD path, and uniform, cosine and BRDF sampling) for up to eight samples of one
+/// pixel, bit for bit: per lane the direction is drawn as [`super::estimator::one_sample`] draws it; then the
+/// shadow rays of the directions aimed at a light go together ([`ShadowRays`]) and the traced directions walk the
+/// tree together, interleaved ([`TracedRays`]). Each lane's stream `rngs[l]` continues after the camera's two
+/// uniforms. Adds the rays traced to `rays`.
 #[inline]
-pub fn estimate_light_lanes(
+pub fn estimate_one_sample_lanes(
     ctx: &SampleContext,
     strategy: &impl Technique,
     dirs: &Vec3x8,
@@ -139,18 +142,30 @@ pub fn estimate_light_lanes(
 ) -> [Vec3; LANES] {
     let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let mut shadow_rays = ShadowRays::default();
+    let (mut shadow_rays, mut traced) = (ShadowRays::default(), TracedRays::default());
     for l in 0..LANES {
         let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
         emitted[l] = le;
         let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
-        let Target::Emitter { triangle, point } = s.target else { continue };
-        let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
-        reflected[l] = value / s.pdf;
-        shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
+        match s.target {
+            Target::Emitter { triangle, point } => {
+                let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
+                reflected[l] = value / s.pdf;
+                shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
+            }
+            Target::Trace => traced.add(l, &sp, s, rays),
+        }
     }
     let visible = shadow_rays.trace(scene, rays);
-    std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+    for (l, found) in traced.trace(scene).into_iter().enumerate() {
+        if let Some((value, _, s)) = found {
+            reflected[l] = value / s.pdf;
+        }
+    }
+    std::array::from_fn(|l| {
+        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
+        emitted[l] + if shadowed { Vec3::ZERO } else { reflected[l] }
+    })
 }
 
 /// Lane `l`'s shading point (where its camera ray along `dirs` hit, if it did) and the radiance it emits
@@ -275,41 +290,6 @@ pub fn estimate_mis_lanes(
         total += from_brdf[l];
         emitted[l] + total
     })
-}
-
-/// The one-sample estimator `f_r L_i (ω·n) / p(ω)` of a strategy that traces its directions (uniform, cosine,
-/// BRDF sampling) for up to eight samples of one pixel: per lane the direction is drawn as
-/// [`super::estimator::one_sample`] draws it, then the lanes' rays walk the tree together, interleaved
-/// ([`TracedRays`]); a direction aimed at a light is looked up alone. The same values bit for bit. Adds the rays
-/// traced to `rays`.
-#[inline]
-pub fn estimate_traced_lanes(
-    ctx: &SampleContext,
-    strategy: &impl Technique,
-    dirs: &Vec3x8,
-    hits: &HitLanes,
-    rngs: &mut [SampleRng; LANES],
-    rays: &mut u64,
-) -> [Vec3; LANES] {
-    let scene = ctx.scene;
-    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let mut traced = TracedRays::default();
-    for l in 0..LANES {
-        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
-        emitted[l] = le;
-        let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
-        if let Target::Trace = s.target {
-            traced.add(l, &sp, s, rays);
-        } else if let Ok((value, _)) = super::estimator::integrand(scene, &sp, &s, rays) {
-            reflected[l] = value / s.pdf;
-        }
-    }
-    for (l, found) in traced.trace(scene).into_iter().enumerate() {
-        if let Some((value, _, s)) = found {
-            reflected[l] = value / s.pdf;
-        }
-    }
-    std::array::from_fn(|l| emitted[l] + reflected[l])
 }
 
 /// Sampled directions to trace, gathered lane by lane (`integrand`'s first half: f_r and ω·n, the ray's origin off

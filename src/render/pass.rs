@@ -3,8 +3,7 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{
-    LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_light_lanes, estimate_mis_lanes,
-    estimate_traced_lanes,
+    LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_lanes, estimate_one_sample_lanes,
 };
 use super::sink::{Census, Learner};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
@@ -372,18 +371,18 @@ impl Renderer {
                 let ctx = self.context();
                 // The bundled light strategies' own code, inlined; any other through the registry.
                 match strategy {
-                    Strategy::SolidAngle => estimate_light_lanes(&ctx, &SolidAngle, &dirs, &hits, &mut rngs, rays),
+                    Strategy::SolidAngle => estimate_one_sample_lanes(&ctx, &SolidAngle, &dirs, &hits, &mut rngs, rays),
                     Strategy::ProjectedSolidAngle => {
-                        estimate_light_lanes(&ctx, &ProjectedSolidAngle, &dirs, &hits, &mut rngs, rays)
+                        estimate_one_sample_lanes(&ctx, &ProjectedSolidAngle, &dirs, &hits, &mut rngs, rays)
                     }
-                    _ => estimate_light_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
+                    _ => estimate_one_sample_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
                 }
             }
             // The hemisphere strategies: their rays walk the tree together.
             (Strategy::Uniform | Strategy::Cosine | Strategy::Brdf, _) if learned.is_none() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
                 let ctx = self.context();
-                estimate_traced_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
+                estimate_one_sample_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
             }
             // `guided` with its guide frozen (training passes record every direction one sample at a time).
             (Strategy::Guided, _) if learned.is_none() => {

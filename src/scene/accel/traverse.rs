@@ -64,7 +64,7 @@ impl Accel {
     /// takes alone, so its hit is [`Accel::closest_hit`]'s, bit for bit.
     #[inline]
     pub fn closest_hits(&self, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> [Option<Hit>; 8] {
-        let Some(root) = self.root else { return [None; 8] };
+        let Some(root) = self.root.filter(|_| active != 0) else { return [None; 8] };
         let mut walks: [Option<ClosestHitWalk>; 8] = Default::default();
         for_each_lane(active, |l| walks[l] = Some(ClosestHitWalk::new(root, rays[l].0, rays[l].1, t_max)));
         let mut walking = active;
