@@ -10,7 +10,7 @@
 //! into passes, provided every sample of an iteration is recorded exactly once. A pass that does not continue
 //! the iteration where the last one stopped (a restart) starts the iteration's records again.
 
-use super::{DEFAULT_WEIGHTS, DTree, Guide, MixtureSample, Moments, STree, Sums, light_fingerprint};
+use super::{DTree, Guide, MixtureSample, Moments, STree, Sums, light_fingerprint};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -244,12 +244,7 @@ impl Training {
             |((sums, moments), records)| {
                 for r in records {
                     sums.record_filtered(r.square, r.value);
-                    // The weights are scored on a quarter of the samples, chosen by their direction's bits (so by
-                    // nothing that depends on the order of the records): scoring costs 25 candidates a sample.
-                    let chosen =
-                        (r.square.x.to_bits() ^ r.square.y.to_bits().rotate_left(16)).wrapping_mul(0x9e37_79b9) >> 30
-                            == 0;
-                    if let (Some(m), true) = (&r.mixture, chosen) {
+                    if let Some(m) = &r.mixture {
                         moments.record(m);
                     }
                 }
@@ -273,14 +268,11 @@ impl Training {
         let threshold = self.settings.spatial_threshold as f64 * (self.iteration as f64).exp2().sqrt();
         let parents = stree.split(&counts, threshold, MAX_STREE_DEPTH);
         let dtrees: Vec<DTree> = parents.iter().map(|&p| densities[p as usize].clone()).collect();
-        // Weights are scored with the densities the samples were drawn with: only where a guide was there.
-        let weights = parents
-            .iter()
-            .map(|&p| {
-                let had_guide = self.guide.dtrees[p as usize].is_usable();
-                if had_guide { self.moments[p as usize].best() } else { DEFAULT_WEIGHTS }
-            })
-            .collect::<Vec<_>>();
+        // Weights are scored from the first iteration on. Where no guide was there, its density was 0 in every
+        // sample, so a candidate with c_g > 0 scores worse than its c_g = 0 counterpart and light and BRDF share the
+        // samples: the next iteration scores the new guide (its density at each direction is recorded whatever its
+        // weight) before the one after samples from it.
+        let weights = parents.iter().map(|&p| self.moments[p as usize].best()).collect::<Vec<_>>();
         for (w, &p) in weights.iter().zip(&parents) {
             if self.sums[p as usize].records > 0 {
                 (0..3).for_each(|k| weight_sum[k] += w[k]);
