@@ -10,7 +10,7 @@ mod common;
 use common::chi2::{SIGNIFICANCE, SphereBins};
 use common::{floor_under_light, on_surface};
 use glam::{DVec3, Vec2, Vec3};
-use illumlab::guiding::{DTree, Guide, STree, Shape, dir_to_square, square_to_dir};
+use illumlab::guiding::{Anchor, DTree, Guide, STree, Shape, dir_to_square, square_to_dir};
 use illumlab::math::{SampleRng, lambert_polygon_irradiance};
 use illumlab::probe::chi2::{p_value, pearson};
 use illumlab::probe::{Probe, ProbeRun, density};
@@ -20,7 +20,7 @@ use std::f32::consts::PI;
 use std::sync::Arc;
 
 /// The chi-square tests in this file, for the Šidák correction.
-const CHI2_TESTS: usize = 7;
+const CHI2_TESTS: usize = 11;
 
 fn level() -> f64 {
     1.0 - (1.0 - SIGNIFICANCE).powf(1.0 / CHI2_TESTS as f64)
@@ -106,6 +106,30 @@ fn the_quadtree_sampler_matches_its_density_on_the_whole_sphere() {
     }
 }
 
+/// A quadtree seen from an anchor (parallax-aware: directions at p aimed at c + R d), sampled at a point off the
+/// anchor: its draws against its density (`pdf_at`, the quadtree's times the Jacobian), binned on the sphere.
+#[test]
+fn the_anchored_quadtree_matches_its_density_off_the_anchor() {
+    let anchor = Anchor { centre: Vec3::new(0.1, 0.2, -0.1), radius: 2.0 };
+    let p = Vec3::new(0.45, -0.15, 0.5);
+    assert!(anchor.reaches(p));
+    let trees = synthetic_trees().into_iter().filter(|(name, _)| *name != "hot leaf at depth 10");
+    for (i, (name, tree)) in trees.enumerate() {
+        let tree = tree.with_anchor(Some(anchor));
+        let bins = SphereBins { axis: Vec3::Z, cos_min: -1.0, res_cos: 32, res_phi: 32 };
+        let draw = |u: Vec2| {
+            let mut rng = SampleRng::new(17, (u.x * 1e9) as u64, (u.y * 1e9) as u64);
+            let (w, pdf) = tree.sample_at(p, &mut rng)?;
+            let at = tree.pdf_at(p, w);
+            assert!((pdf - at).abs() <= 1e-3 * at, "{name}: draw's pdf {pdf} against pdf_at {at}");
+            Some(w)
+        };
+        let out = bins.test(100_000, 40 + i as u64, &draw, &|w| tree.pdf_at(p, w) as f64, 12);
+        assert!((out.integral - 1.0).abs() < 2e-3, "{name}: ∫ pdf = {}", out.integral);
+        assert!(out.p_value > level(), "{name}: anchored chi-square p = {:.2e}", out.p_value);
+    }
+}
+
 /// A floor under a square light (1 m, 1.5 m up), seen by a camera from above, for training.
 fn lit_floor() -> (Scene, common::FloorUnderLight) {
     let f = floor_under_light(1.0, 1.5, Vec3::splat(4.0), 2.0);
@@ -144,10 +168,13 @@ fn the_mixture_matches_its_density_at_a_frozen_guide() {
         let w = square_to_dir(c + Vec2::splat(side * 0.5));
         side * side * (0.05 + w.y.max(0.0).powi(3))
     });
-    let guide = Guide::new(STree::new(Vec3::splat(-2.0), Vec3::splat(2.0)), vec![tree], 0);
-    let ctx = context(&scene, emitters.as_ref(), &guide);
+    // Its directions seen from the shading point itself, and from an anchor above the floor (parallax-aware).
+    let anchored = tree.clone().with_anchor(Some(Anchor { centre: Vec3::new(0.5, 0.2, 0.3), radius: 3.0 }));
+    let guides = [tree, anchored].map(|t| Guide::new(STree::new(Vec3::splat(-2.0), Vec3::splat(2.0)), vec![t], 0));
     let material = scene.materials[0];
-    for (i, p) in [Vec3::new(0.2, 0.0, -0.1), Vec3::new(1.4, 0.0, 0.9)].into_iter().enumerate() {
+    let points = [Vec3::new(0.2, 0.0, -0.1), Vec3::new(1.4, 0.0, 0.9)];
+    for (i, (guide, p)) in guides.iter().flat_map(|g| points.map(|p| (g, p))).enumerate() {
+        let ctx = context(&scene, emitters.as_ref(), guide);
         let sp = on_surface(&scene, p, Vec3::Y, Vec3::new(0.3, 1.0, 0.2).normalize(), &material);
         assert_eq!(illumlab::render::strategy::guided::weights(&ctx, &sp), [0.5, 0.25, 0.25]);
         let bins = SphereBins { axis: Vec3::Z, cos_min: -1.0, res_cos: 32, res_phi: 32 };

@@ -13,6 +13,7 @@
 //! ∫_cell L_i dω, so p(ω) ∝ L_i (piecewise constant) as the records grow. A tree whose energies are all zero has
 //! no density (`pdf` is 0, `sample` gives `None`): the strategy that uses it then takes no guided samples.
 
+use super::parallax::Anchor;
 use super::shape::{Node, Shape, quadrant};
 use crate::math::SampleRng;
 use glam::{DVec2, Vec2, Vec3};
@@ -56,12 +57,14 @@ pub struct Sums {
     /// Per node, per quadrant (only leaves receive records).
     sums: Vec<[u128; 4]>,
     pub records: u64,
+    /// Σ value and Σ value · distance over the records that found light at a known distance from the anchor.
+    anchored: [u128; 2],
 }
 
 impl Sums {
     pub fn new(shape: Shape) -> Self {
         let sums = vec![[0; 4]; shape.nodes.len()];
-        Self { shape, sums, records: 0 }
+        Self { shape, sums, records: 0, anchored: [0; 2] }
     }
 
     pub fn shape(&self) -> &Shape {
@@ -81,6 +84,16 @@ impl Sums {
     /// opening's directions without holes). The square wraps around in φ and is cut at the poles (the energy
     /// stays whole). Leaves receive their share of the square's area.
     pub fn record_filtered(&mut self, s: Vec2, value: f32) {
+        self.record_filtered_at(s, value, None);
+    }
+
+    /// [`Sums::record_filtered`] of a record that found light at `distance` from the leaf's anchor (see
+    /// [`Anchor`]): R is their energy-weighted mean.
+    pub fn record_filtered_at(&mut self, s: Vec2, value: f32, distance: Option<f32>) {
+        if let Some(r) = distance.filter(|r| r.is_finite() && *r > 0.0) {
+            self.anchored[0] = self.anchored[0].saturating_add(fixed_point(value));
+            self.anchored[1] = self.anchored[1].saturating_add(fixed_point(value * r));
+        }
         let side = self.shape.leaf_side(s) as f64;
         let (lo, hi) = (s.as_dvec2() - side * 0.5, s.as_dvec2() + side * 0.5);
         let (x0, x1) = (lo.x.max(0.0), hi.x.min(1.0));
@@ -120,6 +133,15 @@ impl Sums {
         }
     }
 
+    /// The density the sums describe, its directions seen from `centre` at the records' mean distance (see
+    /// [`Anchor`]; directions at the shading point where no record gave a distance).
+    pub fn density_about(&self, centre: Vec3) -> DTree {
+        let [energy, weighted] = self.anchored;
+        let radius = (weighted as f64 / energy as f64) as f32;
+        let anchor = (energy > 0 && radius.is_finite() && radius > 0.0).then_some(Anchor { centre, radius });
+        DTree { anchor, ..self.density() }
+    }
+
     /// The density the sums describe: each node's quadrant energies summed up from its leaves.
     pub fn density(&self) -> DTree {
         let mut energy = vec![[0.0f64; 4]; self.shape.nodes.len()];
@@ -136,7 +158,7 @@ impl Sums {
             sum
         }
         total(self, &mut energy, 0);
-        DTree { shape: self.shape.clone(), energy }
+        DTree { shape: self.shape.clone(), energy, anchor: None }
     }
 }
 
@@ -153,12 +175,14 @@ pub struct DTree {
     shape: Shape,
     /// Per node, per quadrant: the energy below it.
     energy: Vec<[f64; 4]>,
+    /// Where its directions are seen from (`None`: from the shading point itself).
+    anchor: Option<Anchor>,
 }
 
 impl Default for DTree {
     /// The root with no energy: no density.
     fn default() -> Self {
-        Self { shape: Shape::default(), energy: vec![[0.0; 4]] }
+        Self { shape: Shape::default(), energy: vec![[0.0; 4]], anchor: None }
     }
 }
 
@@ -190,6 +214,46 @@ impl DTree {
         &self.shape
     }
 
+    /// The same tree with its directions seen from `anchor`.
+    pub fn with_anchor(self, anchor: Option<Anchor>) -> Self {
+        Self { anchor, ..self }
+    }
+
+    /// The anchor, where it reaches `p`.
+    #[inline]
+    fn anchor_at(&self, p: Vec3) -> Option<Anchor> {
+        self.anchor.filter(|a| a.reaches(p))
+    }
+
+    /// The density w.r.t. solid angle at the shading point `p` of drawing `wi` with [`DTree::sample_at`]: the
+    /// quadtree's density of the anchor's direction times `dΩ_c/dΩ_p` (see [`Anchor`]), or [`DTree::pdf`] of
+    /// `wi` itself where no anchor reaches `p`.
+    #[inline]
+    pub fn pdf_at(&self, p: Vec3, wi: Vec3) -> f32 {
+        match self.anchor_at(p) {
+            Some(a) => {
+                let (d, jacobian) = a.from_point(p, wi);
+                self.pdf(d) * jacobian
+            }
+            None => self.pdf(wi),
+        }
+    }
+
+    /// Draws a direction at the shading point `p`: an anchor's direction from the quadtree, aimed at from `p`
+    /// (see [`Anchor`]), or the quadtree's direction itself where no anchor reaches `p`; with its density (which
+    /// [`DTree::pdf_at`] gives too, but for rounding).
+    #[inline]
+    pub fn sample_at(&self, p: Vec3, rng: &mut SampleRng) -> Option<(Vec3, f32)> {
+        match self.anchor_at(p) {
+            Some(a) => {
+                let (d, pdf) = self.sample(rng)?;
+                let (wi, jacobian) = a.to_point(p, d);
+                Some((wi, pdf * jacobian))
+            }
+            None => self.sample(rng),
+        }
+    }
+
     /// Whether it has a density to draw from.
     #[inline]
     pub fn is_usable(&self) -> bool {
@@ -199,6 +263,7 @@ impl DTree {
     /// Bytes it occupies (nodes and energies).
     pub fn bytes(&self) -> usize {
         self.shape.nodes.len() * (std::mem::size_of::<Node>() + std::mem::size_of::<[f64; 4]>())
+            + std::mem::size_of::<Option<Anchor>>()
     }
 
     /// The density w.r.t. solid angle of drawing the unit direction `w`: `(1/4π) Π 4 E_q / Σ E`.

@@ -12,17 +12,20 @@
 //!
 //! Records are splatted with Müller's box filters, spatially (a jittered position within the leaf's box) and
 //! over directions (a square as wide as the record's quadtree leaf), and each leaf learns its mixture weights
-//! (see [`mixture`]). Written from the papers (whose code is GPL-3: none is copied). The guide learns light
-//! only, so a change of camera or material keeps it.
+//! (see [`mixture`]). Each quadtree learns its light as seen from its leaf's centre, so that every point of the
+//! leaf aims at the same light points ([`Anchor`]: parallax-aware guiding). Written from the papers (whose code
+//! is GPL-3: none is copied). The guide learns light only, so a change of camera or material keeps it.
 
 mod dtree;
 mod mixture;
+mod parallax;
 mod shape;
 mod stree;
 mod training;
 
 pub use dtree::{DTree, Sums, dir_to_square, square_to_dir};
 pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
+pub use parallax::{Anchor, anchor_direction};
 pub use shape::Shape;
 pub use stree::{LeafHint, STree};
 pub use training::{GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
@@ -37,6 +40,8 @@ pub struct Guide {
     pub dtrees: Vec<DTree>,
     /// Per spatial leaf: the mixture weights (c_g, c_l, c_b) `guided` samples with there.
     pub weights: Vec<[f32; 3]>,
+    /// Per spatial leaf: the centre of its box, the anchor of the quadtree it records into (see [`Anchor`]).
+    pub centres: Vec<Vec3>,
     /// Which scene's light it learned: [`light_fingerprint`] of that scene.
     pub fingerprint: u64,
 }
@@ -45,7 +50,8 @@ impl Guide {
     /// A guide of the given leaves' quadtrees, with the default mixture weights everywhere.
     pub fn new(stree: STree, dtrees: Vec<DTree>, fingerprint: u64) -> Self {
         let weights = vec![DEFAULT_WEIGHTS; dtrees.len()];
-        Self { stree, dtrees, weights, fingerprint }
+        let centres = stree.leaf_centres();
+        Self { stree, dtrees, weights, centres, fingerprint }
     }
 
     /// A guide with no energy (no density anywhere) over the box `lo..hi`.

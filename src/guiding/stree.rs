@@ -105,6 +105,26 @@ impl STree {
         }
     }
 
+    /// The centre of every leaf's box, by leaf (the anchors of their quadtrees: see [`super::Anchor`]).
+    pub fn leaf_centres(&self) -> Vec<Vec3> {
+        let mut centres = vec![Vec3::ZERO; self.leaves];
+        let mut stack = vec![(0usize, 0usize, Vec3::ZERO, Vec3::ONE)];
+        while let Some((node, axis, lo, size)) = stack.pop() {
+            match self.nodes[node] {
+                SNode::Leaf(leaf) => centres[leaf as usize] = self.origin + (lo + size * 0.5) * self.side,
+                SNode::Inner(children) => {
+                    let mut half = size;
+                    half[axis] *= 0.5;
+                    let mut upper = lo;
+                    upper[axis] += half[axis];
+                    stack.push((children[0] as usize, (axis + 1) % 3, lo, half));
+                    stack.push((children[1] as usize, (axis + 1) % 3, upper, half));
+                }
+            }
+        }
+        centres
+    }
+
     /// Splits every leaf whose count exceeds `threshold`, and each half again while half the count exceeds it
     /// (Müller's halving of the statistical weight), keeping the tree at most `max_depth` levels deep. Returns,
     /// per new leaf, the old leaf it came from (whose quadtree it starts from).
@@ -197,6 +217,12 @@ mod tests {
         assert_eq!(tree.leaves(), 19);
         assert_eq!(parents.iter().filter(|&&p| p == 3).count(), 4);
         assert!(parents.windows(2).all(|w| w[0] <= w[1]), "new leaves keep the old leaves' order");
+        // Every leaf's centre lies in that leaf, and in no other.
+        let centres = tree.leaf_centres();
+        assert_eq!(centres.len(), tree.leaves());
+        for (leaf, c) in centres.iter().enumerate() {
+            assert_eq!(tree.leaf(*c), leaf as u32, "centre {c}");
+        }
     }
 
     /// A hint gives the leaf a descent gives, for points inside, on and beyond its box's faces, after splits

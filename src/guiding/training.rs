@@ -41,7 +41,7 @@ pub struct GuideSettings {
 
 impl Default for GuideSettings {
     fn default() -> Self {
-        Self { training_spp: 64, spatial_threshold: 250, discard_training: false }
+        Self { training_spp: 64, spatial_threshold: 500, discard_training: false }
     }
 }
 
@@ -58,13 +58,16 @@ pub fn iteration_samples(k: u32) -> Range<u32> {
     start.min(u32::MAX as u64) as u32..((1u64 << (k + 1)) - 1).min(u32::MAX as u64) as u32
 }
 
-/// One recorded direction: the spatial leaf of its point, its square point, and `L_i / p` (luminance); for a
-/// sample of `guided` itself, what its leaf's mixture weights learn from.
+/// One recorded direction: the spatial leaf of its point, its square point (for a record that found light, of the
+/// direction from the leaf's anchor toward where it found it: see [`super::Anchor`]), and `L_i / p`
+/// (luminance); for a sample of `guided` itself, what its leaf's mixture weights learn from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GuideRecord {
     pub leaf: u32,
     pub square: Vec2,
     pub value: f32,
+    /// For a record that found light: the distance from its leaf's anchor to where it found it.
+    pub distance: Option<f32>,
     pub mixture: Option<MixtureSample>,
 }
 
@@ -243,7 +246,7 @@ impl Training {
         self.sums.par_iter_mut().zip(self.moments.par_iter_mut()).zip(by_leaf).for_each(
             |((sums, moments), records)| {
                 for r in records {
-                    sums.record_filtered(r.square, r.value);
+                    sums.record_filtered_at(r.square, r.value, r.distance);
                     if let Some(m) = &r.mixture {
                         moments.record(m);
                     }
@@ -261,7 +264,8 @@ impl Training {
     fn build(&mut self) {
         let start = Instant::now();
         let records: u64 = self.sums.iter().map(|s| s.records).sum();
-        let densities: Vec<DTree> = self.sums.par_iter().map(Sums::density).collect();
+        let densities: Vec<DTree> =
+            self.sums.par_iter().zip(&self.guide.centres).map(|(s, &c)| s.density_about(c)).collect();
         let (mut weight_sum, mut lit_leaves) = ([0.0f32; 3], 0);
         let counts: Vec<u64> = self.sums.iter().map(|s| s.records).collect();
         let mut stree: STree = self.guide.stree.clone();
@@ -281,7 +285,8 @@ impl Training {
         }
         self.sums = dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
         self.moments = vec![Moments::default(); dtrees.len()];
-        self.guide = Arc::new(Guide { stree, dtrees, weights, fingerprint: self.guide.fingerprint });
+        let centres = stree.leaf_centres();
+        self.guide = Arc::new(Guide { stree, dtrees, weights, centres, fingerprint: self.guide.fingerprint });
         self.log.push(IterationReport {
             iteration: self.iteration,
             spp: iteration_samples(self.iteration).end,

@@ -105,11 +105,11 @@ pub fn chi_square(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, sa
 /// `guided`'s guide part alone: its quadtree's draws at the point against the quadtree's density, on the sphere.
 fn chi_square_guide(ctx: &SampleContext, sp: &ShadingPoint, samples: u64, seed: u64) -> ChiSquare {
     let dtree = ctx.guide.map(|g| g.dtree(sp.p));
-    let pdf = |w: Vec3, _: Option<Reached>| dtree.map_or(0.0, |d| d.pdf(w));
+    let pdf = |w: Vec3, _: Option<Reached>| dtree.map_or(0.0, |d| d.pdf_at(sp.p, w));
     let frame = Frame::from_z(sp.n);
     let observed_cell = |k: u64| {
         let mut rng = SampleRng::new(seed, u64::MAX - 13, k);
-        dtree.and_then(|d| d.sample(&mut rng)).map(|(w, _)| sphere_cell(frame.to_local(w)))
+        dtree.and_then(|d| d.sample_at(sp.p, &mut rng)).map(|(w, _)| sphere_cell(frame.to_local(w)))
     };
     tally(sphere_cells(sp, &pdf), samples, "sphere (guide)", None, observed_cell)
 }

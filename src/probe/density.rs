@@ -37,7 +37,7 @@ pub fn density(ctx: &SampleContext, sp: &ShadingPoint, strategy: Strategy, wi: V
         }
         Domain::Learned => {
             let [c_g, c_l, c_b] = guided::weights(ctx, sp);
-            let guide = ctx.guide.map_or(0.0, |g| g.dtree(sp.p).pdf(wi));
+            let guide = ctx.guide.map_or(0.0, |g| g.dtree(sp.p).pdf_at(sp.p, wi));
             let light = if c_l > 0.0 { density(ctx, sp, Strategy::Emitter, wi) } else { 0.0 };
             c_g * guide + c_l * light + c_b * density(ctx, sp, Strategy::Brdf, wi)
         }

@@ -82,7 +82,9 @@ impl Maps {
         let guide = ctx.guide.map(|g| {
             let dtree = g.dtree(sp.p);
             (0..size * size)
-                .map(|i| disk_point(i, size).map_or(f32::NAN, |d| dtree.pdf(frame.to_world(disk_to_hemisphere(d)))))
+                .map(|i| {
+                    disk_point(i, size).map_or(f32::NAN, |d| dtree.pdf_at(sp.p, frame.to_world(disk_to_hemisphere(d))))
+                })
                 .collect()
         });
         Self {

@@ -40,13 +40,13 @@ pub fn one_sample<S: SampleSink>(
         sink.record(SampleRecord::none(0));
         return Vec3::ZERO;
     };
-    let (contribution, radiance, outcome) = match integrand(scene, sp, &s, rays) {
-        Ok((value, via)) => (value / s.pdf, scene.emitted(via.triangle, -s.wi), Outcome::Contributed),
-        Err(outcome) => (Vec3::ZERO, Vec3::ZERO, outcome),
+    let (contribution, radiance, outcome, hit) = match integrand(scene, sp, &s, rays) {
+        Ok((value, via)) => (value / s.pdf, scene.emitted(via.triangle, -s.wi), Outcome::Contributed, via.point),
+        Err(outcome) => (Vec3::ZERO, Vec3::ZERO, outcome, Vec3::ZERO),
     };
     let (wi, pdf) = (s.wi, s.pdf);
     let parts = [0.0; 3];
-    sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts });
+    sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts, hit });
     contribution
 }
 

@@ -4,7 +4,7 @@
 //! sink is a type parameter, so the production path, which passes `()`,
 //! builds no record and pays nothing.
 
-use crate::guiding::{GuideRecord, MixtureSample, STree, dir_to_square};
+use crate::guiding::{GuideRecord, MixtureSample, STree, anchor_direction, dir_to_square};
 use crate::math::{luminance, mix64};
 use glam::Vec3;
 
@@ -73,6 +73,8 @@ pub struct SampleRecord {
     /// For a one-sample mixture over a learned guide (`guided`): the densities of its guide, light and BRDF
     /// parts at ω_k, of which `pdf` is the weighted sum. Zero for every other strategy.
     pub parts: [f32; 3],
+    /// The point on an emitter where L_i was found (zero where none was).
+    pub hit: Vec3,
 }
 
 impl SampleRecord {
@@ -81,7 +83,7 @@ impl SampleRecord {
     pub fn none(technique: u8) -> Self {
         let (wi, contribution, radiance) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
         let (pdf, outcome, parts) = (0.0, Outcome::NoSample, [0.0; 3]);
-        Self { technique, wi, pdf, mis_weight: 0.0, contribution, radiance, outcome, parts }
+        Self { technique, wi, pdf, mis_weight: 0.0, contribution, radiance, outcome, parts, hit: Vec3::ZERO }
     }
 
     /// Whether L_i was found along ω_k (a ray was traced): what a learning strategy can learn from.
@@ -138,9 +140,13 @@ impl SampleSink for Census {
 ///
 /// Each record goes to the leaf of a point jittered uniformly within the box of the shading point's leaf
 /// (Müller et al. 2017's stochastic spatial box filter, so that neighbouring leaves share what they learn); the
-/// jitter is a hash of the point and the direction, so it depends on nothing but the sample.
+/// jitter is a hash of the point and the direction, so it depends on nothing but the sample. A record that found
+/// light goes in as the direction from that leaf's anchor toward the point where it found it, with its distance
+/// ([`crate::guiding::Anchor`]); the others, which add no energy, as their own direction.
 pub(super) struct Learner<'a> {
     pub(super) stree: &'a STree,
+    /// Per leaf: its anchor (the centre of its box).
+    pub(super) centres: &'a [Vec3],
     pub(super) p: Vec3,
     /// The size of the box of the leaf holding p.
     pub(super) extent: Vec3,
@@ -170,7 +176,13 @@ impl SampleSink for Learner<'_> {
                 pdf: r.pdf,
                 parts: r.parts,
             });
-            self.out.push(GuideRecord { leaf, square: dir_to_square(r.wi), value, mixture });
+            // Light found: its direction as the leaf's anchor sees it, and its distance from there.
+            let anchored = (value > 0.0).then(|| anchor_direction(self.centres[leaf as usize], r.hit)).flatten();
+            let (square, distance) = match anchored {
+                Some((d, distance)) => (dir_to_square(d), Some(distance)),
+                None => (dir_to_square(r.wi), None),
+            };
+            self.out.push(GuideRecord { leaf, square, value, distance, mixture });
         }
     }
 }

@@ -67,7 +67,7 @@ impl<'a> Mixture<'a> {
     /// weight: the weights learn from it).
     #[inline]
     fn parts(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> [f32; 3] {
-        let guide = self.dtree.map_or(0.0, |d| d.pdf(wi));
+        let guide = self.dtree.map_or(0.0, |d| d.pdf_at(sp.p, wi));
         let light = if ctx.emitters.is_some() { Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
         [guide, light, Technique::pdf(&Brdf, ctx, sp, wi, via)]
     }
@@ -103,7 +103,7 @@ impl Guided {
         let m = Mixture::at_near(ctx, sp, hint);
         let s = match choose(&m.w, rng.uniform()) {
             0 => {
-                let (wi, pdf) = m.dtree?.sample(rng)?;
+                let (wi, pdf) = m.dtree?.sample_at(sp.p, rng)?;
                 DirectionSample { wi, pdf, target: Target::Trace }
             }
             1 => Technique::sample(&Emitter, ctx, sp, rng)?,
@@ -182,11 +182,11 @@ impl DirectionStrategy for Guided {
             sink.record(SampleRecord::none(0));
             return Vec3::ZERO;
         };
-        let (contribution, parts, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+        let (contribution, parts, radiance, outcome, hit) = match integrand(ctx.scene, sp, &s, rays) {
             Ok((value, via)) => {
                 let parts = m.parts(ctx, sp, s.wi, Some(via));
                 let radiance = ctx.scene.emitted(via.triangle, -s.wi);
-                (value / m.pdf(&parts), parts, radiance, Outcome::Contributed)
+                (value / m.pdf(&parts), parts, radiance, Outcome::Contributed, via.point)
             }
             Err(outcome) => {
                 // An occluded or missed direction still tells the guide something: L_i = 0 there.
@@ -194,11 +194,21 @@ impl DirectionStrategy for Guided {
                     Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
                     Target::Trace => None,
                 };
-                (Vec3::ZERO, m.parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome)
+                (Vec3::ZERO, m.parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome, Vec3::ZERO)
             }
         };
         let (wi, pdf) = (s.wi, m.pdf(&parts));
-        sink.record(SampleRecord { technique: 0, wi, pdf, mis_weight: 1.0, contribution, radiance, outcome, parts });
+        sink.record(SampleRecord {
+            technique: 0,
+            wi,
+            pdf,
+            mis_weight: 1.0,
+            contribution,
+            radiance,
+            outcome,
+            parts,
+            hit,
+        });
         contribution
     }
 }

@@ -185,12 +185,12 @@ fn directions<S: SampleSink>(
             sink.record(SampleRecord::none(i as u8));
             continue;
         };
-        let (contribution, w, radiance, outcome) = match integrand(ctx.scene, sp, &s, rays) {
+        let (contribution, w, radiance, outcome, hit) = match integrand(ctx.scene, sp, &s, rays) {
             Ok((value, via)) => {
                 let p_other = other.pdf(&contexts[1 - i], sp, s.wi, Some(via));
                 let w = heuristic.weight(n[i], s.pdf, n[1 - i], p_other);
                 let radiance = ctx.scene.emitted(via.triangle, -s.wi);
-                (value * (w / (n[i] as f32 * s.pdf)), w, radiance, Outcome::Contributed)
+                (value * (w / (n[i] as f32 * s.pdf)), w, radiance, Outcome::Contributed, via.point)
             }
             Err(outcome) => {
                 // L_i = 0 along ω: weighted as if it had arrived (the weight of a zero is the record's only use).
@@ -199,13 +199,13 @@ fn directions<S: SampleSink>(
                     super::Target::Trace => None,
                 };
                 let p_other = other.pdf(&contexts[1 - i], sp, s.wi, via);
-                (Vec3::ZERO, heuristic.weight(n[i], s.pdf, n[1 - i], p_other), Vec3::ZERO, outcome)
+                (Vec3::ZERO, heuristic.weight(n[i], s.pdf, n[1 - i], p_other), Vec3::ZERO, outcome, Vec3::ZERO)
             }
         };
         total += contribution;
         let (wi, pdf, technique) = (s.wi, s.pdf, i as u8);
         let parts = [0.0; 3];
-        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, radiance, outcome, parts });
+        sink.record(SampleRecord { technique, wi, pdf, mis_weight: w, contribution, radiance, outcome, parts, hit });
     }
     total
 }
