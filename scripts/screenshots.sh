@@ -3,7 +3,10 @@
 # screenshots/viewer-<scene>-<strategy>.png for each bundled scene and a few strategies, and compare mode
 # (screenshots/viewer-compare-*.png; references are rendered into a temporary cache).
 # Needs: xvfb xauth mesa-vulkan-drivers libvulkan1 libegl1 libgl1-mesa-dri imagemagick (Debian).
+# With an argument, takes only the screenshots whose file name contains it (e.g. `occluded-light`).
 set -euo pipefail
+only=${1:-}
+wanted() { [[ -z $only || $1 == *"$only"* ]]; }
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
 bin=$PWD/target/release/illumlab
@@ -12,6 +15,7 @@ runtime=$(mktemp -d); chmod 700 "$runtime"; export XDG_RUNTIME_DIR=$runtime
 export XDG_CACHE_HOME=$runtime/cache
 shoot() { # scene strategy exposure
   local out="screenshots/viewer-$1-$2.png"
+  wanted "$out" || return 0
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
     '$bin' view '$1' --strategy '$2' --exposure '$3' --target-spp 1024 & pid=\$!
     sleep $wait_s
@@ -30,6 +34,7 @@ shoot occluded-light guided 1
 shoot_compare() { # name warm-up-seconds seconds scene args…
   # The first run renders the reference into the cache, so the second records convergence from 1 spp.
   local out="screenshots/viewer-compare-$1.png" warm=$2 wait=$3 scene=$4; shift 4
+  wanted "$out" || return 0
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
     '$bin' view '$scene' $* & pid=\$!
     sleep $warm; kill \$pid; wait \$pid 2>/dev/null || true
@@ -49,6 +54,7 @@ shoot_compare occluded-light 1 40 occluded-light --strategy mis --compare guided
 shoot_compare plot 50 30 near-light --strategy emitter --compare projected-solid-angle --budget equal-time --target-spp 512 --reference-spp 512 --plot --exposure -2
 shoot_probe() { # name seconds scene args…
   local out="screenshots/viewer-probe-$1.png" wait=$2 scene=$3; shift 3
+  wanted "$out" || return 0
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
     '$bin' view '$scene' $* & pid=\$!
     sleep $wait
