@@ -84,9 +84,10 @@ impl Guide {
         self.dtrees.iter().map(|d| d.shape().nodes()).sum()
     }
 
-    /// Bytes the guide occupies.
+    /// Bytes the guide occupies: the quadtrees, the spatial nodes, and each leaf's weights and anchor.
     pub fn bytes(&self) -> usize {
-        self.dtrees.iter().map(DTree::bytes).sum::<usize>() + self.stree.nodes() * 8
+        let per_leaf = std::mem::size_of::<[f32; 3]>() + std::mem::size_of::<Vec3>();
+        self.dtrees.iter().map(DTree::bytes).sum::<usize>() + self.stree.nodes() * 8 + self.weights.len() * per_leaf
     }
 
     /// Whether any leaf has a density.
