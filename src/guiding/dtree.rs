@@ -82,14 +82,9 @@ impl Sums {
     /// Adds `value` spread evenly over a square as wide as the leaf holding `s`, centred on `s` (Müller et al.
     /// 2019's directional box filter: a record informs the cells around its own, so that few records cover an
     /// opening's directions without holes). The square wraps around in φ and is cut at the poles (the energy
-    /// stays whole). Leaves receive their share of the square's area.
-    pub fn record_filtered(&mut self, s: Vec2, value: f32) {
-        self.record_filtered_at(s, value, None);
-    }
-
-    /// [`Sums::record_filtered`] of a record that found light at `distance` from the leaf's anchor (see
-    /// [`Anchor`]): R is their energy-weighted mean.
-    pub fn record_filtered_at(&mut self, s: Vec2, value: f32, distance: Option<f32>) {
+    /// stays whole). Leaves receive their share of the square's area. A record that found light at `distance`
+    /// from the leaf's anchor (see [`Anchor`]) also adds to the energy-weighted mean distance R.
+    pub fn record_filtered(&mut self, s: Vec2, value: f32, distance: Option<f32>) {
         if let Some(r) = distance.filter(|r| r.is_finite() && *r > 0.0) {
             self.anchored[0] = self.anchored[0].saturating_add(fixed_point(value));
             self.anchored[1] = self.anchored[1].saturating_add(fixed_point(value * r));
@@ -388,14 +383,14 @@ mod tests {
     fn filtered_records_keep_their_energy() {
         let shape = Shape::uniform(4); // leaves of side 1/8
         let mut sums = Sums::new(shape.clone());
-        sums.record_filtered(Vec2::new(0.5, 0.99), 8.0); // straddles φ = 1 and four leaves
+        sums.record_filtered(Vec2::new(0.5, 0.99), 8.0, None); // straddles φ = 1 and four leaves
         let d = sums.density();
         assert!((d.total() - 8.0).abs() < 1e-9, "{}", d.total());
         let filled = shape.leaves().iter().filter(|(c, side)| d.pdf(square_to_dir(*c + *side * 0.5)) > 0.0).count();
         assert_eq!(filled, 4, "two leaves across cos θ, two across the φ seam");
         // At a pole the square is cut and the energy stays whole.
         let mut sums = Sums::new(shape);
-        sums.record_filtered(Vec2::new(0.01, 0.3), 2.0);
+        sums.record_filtered(Vec2::new(0.01, 0.3), 2.0, None);
         assert!((sums.density().total() - 2.0).abs() < 1e-9);
     }
 

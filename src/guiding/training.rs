@@ -246,7 +246,7 @@ impl Training {
         self.sums.par_iter_mut().zip(self.moments.par_iter_mut()).zip(by_leaf).for_each(
             |((sums, moments), records)| {
                 for r in records {
-                    sums.record_filtered_at(r.square, r.value, r.distance);
+                    sums.record_filtered(r.square, r.value, r.distance);
                     if let Some(m) = &r.mixture {
                         moments.record(m);
                     }
