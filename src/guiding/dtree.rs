@@ -79,6 +79,12 @@ impl Sums {
         self.records += 1;
     }
 
+    /// Counts a record that found no light.
+    #[inline]
+    pub fn record_empty(&mut self) {
+        self.records += 1;
+    }
+
     /// Adds `value` spread evenly over a square as wide as the leaf holding `s`, centred on `s` (Müller et al.
     /// 2019's directional box filter: a record informs the cells around its own, so that few records cover an
     /// opening's directions without holes). The square wraps around in φ and is cut at the poles (the energy

@@ -10,7 +10,7 @@
 //! into passes, provided every sample of an iteration is recorded exactly once. A pass that does not continue
 //! the iteration where the last one stopped (a restart) starts the iteration's records again.
 
-use super::{DTree, Guide, MixtureSample, Moments, STree, Sums, light_fingerprint};
+use super::{DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -58,17 +58,29 @@ pub fn iteration_samples(k: u32) -> Range<u32> {
     start.min(u32::MAX as u64) as u32..((1u64 << (k + 1)) - 1).min(u32::MAX as u64) as u32
 }
 
-/// One recorded direction: the spatial leaf of its point, its square point (for a record that found light, of the
-/// direction from the leaf's anchor toward where it found it: see [`super::Anchor`]), and `L_i / p`
-/// (luminance); for a sample of `guided` itself, what its leaf's mixture weights learn from.
+/// One recorded direction: the spatial leaf of its point, and what it found; for a sample of `guided` itself,
+/// what its leaf's mixture weights learn from. A record that found nothing counts toward its leaf's split.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GuideRecord {
     pub leaf: u32,
-    pub square: Vec2,
-    pub value: f32,
-    /// For a record that found light: the distance from its leaf's anchor to where it found it.
-    pub distance: Option<f32>,
+    pub found: Option<Found>,
     pub mixture: Option<MixtureSample>,
+}
+
+/// Light found along a recorded direction: `L_i / p` (luminance, > 0), the shading point and the light's point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Found {
+    pub value: f32,
+    pub from: Vec3,
+    pub at: Vec3,
+}
+
+/// A record that found light as its leaf's quadtree took it: square point, value, distance from the anchor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Lit {
+    square: Vec2,
+    value: f32,
+    distance: Option<f32>,
 }
 
 /// What one iteration built.
@@ -138,6 +150,11 @@ pub struct Training {
     sums: Vec<Sums>,
     /// Per leaf: the mixture weights' candidates scored on the current iteration's samples.
     moments: Vec<Moments>,
+    /// Per leaf: where the current iteration's rays converge.
+    foci: Vec<FocusMoments>,
+    /// Per leaf: the current iteration's records that found light, as recorded (recorded again at the build,
+    /// into a quadtree refined where they put their energy).
+    lit: Vec<Vec<Lit>>,
     iteration: u32,
     /// The sample the current iteration's records continue from.
     next: u32,
@@ -163,8 +180,10 @@ impl Training {
     fn from_guide(guide: Arc<Guide>, settings: GuideSettings) -> Self {
         let sums = guide.dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
         let moments = vec![Moments::default(); guide.dtrees.len()];
+        let foci = vec![FocusMoments::default(); guide.dtrees.len()];
+        let lit = vec![Vec::new(); guide.dtrees.len()];
         let (iteration, next, log, learning) = (0, 0, Vec::new(), Duration::ZERO);
-        Self { settings, guide, sums, moments, iteration, next, log, learning, kept: false }
+        Self { settings, guide, sums, moments, foci, lit, iteration, next, log, learning, kept: false }
     }
 
     /// A guide learned earlier (e.g. kept across a camera change), used as it is: it learns no more.
@@ -221,6 +240,8 @@ impl Training {
             // A restart or a gap: this iteration's records start again from its first sample.
             self.sums.iter_mut().for_each(|s| *s = Sums::new(s.shape().clone()));
             self.moments.iter_mut().for_each(|m| *m = Moments::default());
+            self.foci.iter_mut().for_each(|m| *m = FocusMoments::default());
+            self.lit.iter_mut().for_each(Vec::clear);
             self.next = samples.start;
         }
         if first < samples.start {
@@ -234,7 +255,8 @@ impl Training {
 
     /// Takes the records of samples `self.next..until` (a range [`Training::plan`] said to record); builds the
     /// next guide when they complete the iteration. Leaves take their records in parallel (the sums are exact,
-    /// so the order does not matter).
+    /// so the order does not matter). A record that found light goes into its leaf's quadtree as the direction
+    /// from the leaf's anchor toward the point of its ray at the leaf's focus, with that point's distance.
     pub fn learn(&mut self, records: impl IntoIterator<Item = GuideRecord>, until: u32) {
         let start = Instant::now();
         let mut by_leaf: Vec<Vec<GuideRecord>> = vec![Vec::new(); self.sums.len()];
@@ -243,16 +265,31 @@ impl Training {
                 bucket.push(r);
             }
         }
-        self.sums.par_iter_mut().zip(self.moments.par_iter_mut()).zip(by_leaf).for_each(
-            |((sums, moments), records)| {
-                for r in records {
-                    sums.record_filtered(r.square, r.value, r.distance);
-                    if let Some(m) = &r.mixture {
-                        moments.record(m);
+        let (centres, foci) = (&self.guide.centres, &self.guide.foci);
+        let leaves = self.sums.par_iter_mut().zip(self.moments.par_iter_mut()).zip(self.foci.par_iter_mut());
+        let leaves = leaves.zip(self.lit.par_iter_mut()).zip(by_leaf).enumerate();
+        leaves.for_each(|(leaf, ((((sums, moments), focus), lit), records))| {
+            let (c, f) = (centres[leaf], foci[leaf]);
+            for r in records {
+                match r.found {
+                    Some(Found { value, from, at }) => {
+                        let z = from + (at - from) * f;
+                        let (d, distance) = match anchor_direction(c, z) {
+                            Some((d, distance)) => (d, Some(distance)),
+                            None => ((at - from).normalize_or(Vec3::Z), None),
+                        };
+                        let record = Lit { square: dir_to_square(d), value, distance };
+                        sums.record_filtered(record.square, value, distance);
+                        lit.push(record);
+                        focus.record(from - c, at - c, value);
                     }
+                    None => sums.record_empty(),
                 }
-            },
-        );
+                if let Some(m) = &r.mixture {
+                    moments.record(m);
+                }
+            }
+        });
         self.learning += start.elapsed();
         self.next = until;
         if until == iteration_samples(self.iteration).end {
@@ -264,8 +301,18 @@ impl Training {
     fn build(&mut self) {
         let start = Instant::now();
         let records: u64 = self.sums.iter().map(|s| s.records).sum();
-        let densities: Vec<DTree> =
-            self.sums.par_iter().zip(&self.guide.centres).map(|(s, &c)| s.density_about(c)).collect();
+        // The sums were recorded into a quadtree shaped by the last iteration's light; where this iteration's light
+        // fell elsewhere (a focus that moved, a leaf just split whose anchor moved), its energy was spread over
+        // coarse cells. Recorded again into a quadtree refined where it fell, it is resolved as finely as the rest.
+        let sums = self.sums.par_iter().zip(&self.lit);
+        let densities: Vec<DTree> = sums
+            .zip(&self.guide.centres)
+            .map(|((sums, lit), &c)| {
+                let mut again = Sums::new(sums.density().refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH));
+                lit.iter().for_each(|r| again.record_filtered(r.square, r.value, r.distance));
+                again.density_about(c)
+            })
+            .collect();
         let (mut weight_sum, mut lit_leaves) = ([0.0f32; 3], 0);
         let counts: Vec<u64> = self.sums.iter().map(|s| s.records).collect();
         let mut stree: STree = self.guide.stree.clone();
@@ -277,6 +324,7 @@ impl Training {
         // samples: the next iteration scores the new guide (its density at each direction is recorded whatever its
         // weight) before the one after samples from it.
         let weights = parents.iter().map(|&p| self.moments[p as usize].best()).collect::<Vec<_>>();
+        let foci = parents.iter().map(|&p| self.foci[p as usize].fraction()).collect::<Vec<_>>();
         for (w, &p) in weights.iter().zip(&parents) {
             if self.sums[p as usize].records > 0 {
                 (0..3).for_each(|k| weight_sum[k] += w[k]);
@@ -285,8 +333,11 @@ impl Training {
         }
         self.sums = dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
         self.moments = vec![Moments::default(); dtrees.len()];
+        self.foci = vec![FocusMoments::default(); dtrees.len()];
+        self.lit = vec![Vec::new(); dtrees.len()];
         let centres = stree.leaf_centres();
-        self.guide = Arc::new(Guide { stree, dtrees, weights, centres, fingerprint: self.guide.fingerprint });
+        let fingerprint = self.guide.fingerprint;
+        self.guide = Arc::new(Guide { stree, dtrees, weights, centres, foci, fingerprint });
         self.log.push(IterationReport {
             iteration: self.iteration,
             spp: iteration_samples(self.iteration).end,

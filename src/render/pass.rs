@@ -433,8 +433,7 @@ impl Renderer {
                 // MIS divides technique i's directions by n_i; one-sample strategies take one (technique 0).
                 let samples = if strategy == Strategy::Mis { ctx.mis.samples } else { [1, 1] };
                 let (_, extent) = guide.stree.leaf_extent(sp.p);
-                let centres = &guide.centres;
-                let mut learner = Learner { stree: &guide.stree, centres, p: sp.p, extent, samples, out };
+                let mut learner = Learner { stree: &guide.stree, p: sp.p, extent, samples, out };
                 strategy.estimate(&ctx, &sp, rng, rays, &mut learner)
             }
             _ => strategy.estimate(&ctx, &sp, rng, rays, &mut ()),

@@ -4,7 +4,7 @@
 //! sink is a type parameter, so the production path, which passes `()`,
 //! builds no record and pays nothing.
 
-use crate::guiding::{GuideRecord, MixtureSample, STree, anchor_direction, dir_to_square};
+use crate::guiding::{Found, GuideRecord, MixtureSample, STree};
 use crate::math::{luminance, mix64};
 use glam::Vec3;
 
@@ -141,12 +141,10 @@ impl SampleSink for Census {
 /// Each record goes to the leaf of a point jittered uniformly within the box of the shading point's leaf
 /// (Müller et al. 2017's stochastic spatial box filter, so that neighbouring leaves share what they learn); the
 /// jitter is a hash of the point and the direction, so it depends on nothing but the sample. A record that found
-/// light goes in as the direction from that leaf's anchor toward the point where it found it, with its distance
-/// ([`crate::guiding::Anchor`]); the others, which add no energy, as their own direction.
+/// light carries its ray, from the shading point to the light's point (the leaf learns it where the leaf's rays
+/// converge: [`crate::guiding::Training::learn`]); the others add no energy and only count.
 pub(super) struct Learner<'a> {
     pub(super) stree: &'a STree,
-    /// Per leaf: its anchor (the centre of its box).
-    pub(super) centres: &'a [Vec3],
     pub(super) p: Vec3,
     /// The size of the box of the leaf holding p.
     pub(super) extent: Vec3,
@@ -176,13 +174,8 @@ impl SampleSink for Learner<'_> {
                 pdf: r.pdf,
                 parts: r.parts,
             });
-            // Light found: its direction as the leaf's anchor sees it, and its distance from there.
-            let anchored = (value > 0.0).then(|| anchor_direction(self.centres[leaf as usize], r.hit)).flatten();
-            let (square, distance) = match anchored {
-                Some((d, distance)) => (dir_to_square(d), Some(distance)),
-                None => (dir_to_square(r.wi), None),
-            };
-            self.out.push(GuideRecord { leaf, square, value, distance, mixture });
+            let found = (value > 0.0).then_some(Found { value, from: self.p, at: r.hit });
+            self.out.push(GuideRecord { leaf, found, mixture });
         }
     }
 }
