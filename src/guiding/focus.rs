@@ -19,7 +19,6 @@
 //! y = a/h − x (1 − h)/h for the opening point a, so Cov(x, y) = −(1 − h)/h Var(x) and f = h: the opening itself,
 //! which every point of the leaf sees the light through.
 
-use super::mixture::fixed_point;
 use glam::{DVec3, Vec3};
 
 /// The focus at least this far along a ray (a nearer one would put the learned points beside the leaf).
@@ -28,11 +27,16 @@ pub const MIN_FOCUS: f32 = 0.125;
 /// Lit records a leaf needs before its focus moves from the light.
 const MIN_RECORDS: u32 = 64;
 
-/// A signed value in fixed point (order-independent sums).
+/// Fraction bits of the moments' fixed point.
+const FRACTION_BITS: i32 = 32;
+
+/// The largest term a record adds (2³⁰): a larger one saturates, which can only move the focus.
+const MAX_TERM: f64 = (1u64 << 30) as f64;
+
+/// A term in fixed point (one conversion to i64; order-independent sums).
 #[inline]
-fn signed_fixed_point(v: f64) -> i128 {
-    let m = fixed_point(v.abs()) as i128;
-    if v < 0.0 { -m } else { m }
+fn fixed_point(t: f64) -> i64 {
+    (t.clamp(-MAX_TERM, MAX_TERM) * (FRACTION_BITS as f64).exp2()) as i64
 }
 
 /// Value-weighted moments of one leaf's lit records, x and y relative to its anchor, in fixed point: Σ w, Σ w x,
@@ -52,7 +56,7 @@ impl FocusMoments {
         let (x, y, w) = (x.as_dvec3(), y.as_dvec3(), w as f64);
         let terms = [w, w * x.x, w * x.y, w * x.z, w * y.x, w * y.y, w * y.z, w * x.dot(x), w * x.dot(y)];
         for (sum, t) in self.sums.iter_mut().zip(terms) {
-            *sum = sum.wrapping_add(signed_fixed_point(t));
+            *sum = sum.wrapping_add(fixed_point(t) as i128);
         }
         self.records += 1;
     }

@@ -56,7 +56,7 @@ const MAX_TERM: f64 = (1u64 << 60) as f64;
 /// Whole and fraction are converted apart, each through u64 (one instruction; f64 → u128 is a library call):
 /// every sample scores 25 candidates.
 #[inline]
-pub(super) fn fixed_point(term: f64) -> u128 {
+fn fixed_point(term: f64) -> u128 {
     let t = term.clamp(0.0, MAX_TERM);
     let whole = t.trunc();
     ((whole as u64 as u128) << FRACTION_BITS) + ((t - whole) * (FRACTION_BITS as f64).exp2()) as u64 as u128

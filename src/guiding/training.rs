@@ -10,7 +10,9 @@
 //! into passes, provided every sample of an iteration is recorded exactly once. A pass that does not continue
 //! the iteration where the last one stopped (a restart) starts the iteration's records again.
 
-use super::{DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint};
+use super::{
+    DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint,
+};
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -41,7 +43,7 @@ pub struct GuideSettings {
 
 impl Default for GuideSettings {
     fn default() -> Self {
-        Self { training_spp: 64, spatial_threshold: 500, discard_training: false }
+        Self { training_spp: 64, spatial_threshold: 1000, discard_training: false }
     }
 }
 
@@ -279,7 +281,7 @@ impl Training {
                             None => ((at - from).normalize_or(Vec3::Z), None),
                         };
                         let record = Lit { square: dir_to_square(d), value, distance };
-                        sums.record_filtered(record.square, value, distance);
+                        sums.record(record.square, value);
                         lit.push(record);
                         focus.record(from - c, at - c, value);
                     }
@@ -301,9 +303,10 @@ impl Training {
     fn build(&mut self) {
         let start = Instant::now();
         let records: u64 = self.sums.iter().map(|s| s.records).sum();
-        // The sums were recorded into a quadtree shaped by the last iteration's light; where this iteration's light
-        // fell elsewhere (a focus that moved, a leaf just split whose anchor moved), its energy was spread over
-        // coarse cells. Recorded again into a quadtree refined where it fell, it is resolved as finely as the rest.
+        // The sums were recorded (unfiltered) into a quadtree shaped by the last iteration's light; where this
+        // iteration's light fell elsewhere (a focus that moved, a leaf just split whose anchor moved) they hold it
+        // in coarse cells. They only shape the quadtree the records then go into, filtered: refined where the light
+        // fell, it resolves the light as finely wherever it is.
         let sums = self.sums.par_iter().zip(&self.lit);
         let densities: Vec<DTree> = sums
             .zip(&self.guide.centres)
