@@ -303,7 +303,8 @@ fn training_gives_the_same_image_with_any_thread_count() {
 /// at 128 × 128: within 4 combined standard errors of emitter sampling (unbiased, checked against closed forms
 /// elsewhere; the quadrature resolves a light seen through a small hole too poorly to judge by). There the
 /// learned weights use the guide (c_g > 0; at this coarse size they trust it less than under a guide trained at
-/// 256 × 256), and guided's estimate is the less noisy.
+/// 256 × 256), the leaf learned its light at the opening (the hole is half way from the floor to the light: a
+/// focus within 0.1 of ½), and guided's estimate is the less noisy.
 #[test]
 fn guided_is_unbiased_through_the_opening() {
     let mut scene = load_scene("occluded-light").expect("bundled");
@@ -328,6 +329,8 @@ fn guided_is_unbiased_through_the_opening() {
         assert!(((a - b) / se).abs() < 4.0, "pixel {pixel:?}: guided {a} against emitter {b} (± {se:.2e})");
         let weights = guide.leaf(sp.p).1;
         assert!(weights[0] > 0.0, "pixel {pixel:?}: the learned weights should use the guide: {weights:?}");
+        let focus = guide.foci[guide.stree.leaf(sp.p) as usize];
+        assert!((focus - 0.5).abs() < 0.1, "pixel {pixel:?}: the leaf's focus {focus} should be the hole's, ½");
         variances.push((guided.relative_variance(b), emitter.relative_variance(b)));
         checked += 1;
     }
