@@ -72,6 +72,13 @@ impl STree {
         }
     }
 
+    /// [`STree::leaf_near`] and the size of the leaf's box (as [`STree::leaf_extent`] gives it).
+    #[inline]
+    pub fn leaf_extent_near(&self, p: Vec3, hint: &mut Option<LeafHint>) -> (u32, Vec3) {
+        let leaf = self.leaf_near(p, hint);
+        (leaf, hint.map_or(Vec3::splat(self.side), |h| (h.hi - h.lo) * self.side))
+    }
+
     /// [`STree::leaf`], remembering the leaf's box in `hint`: a point in the box of the hint's leaf is in that
     /// leaf, found without a descent (the samples of one pixel mostly share a leaf). The descent halves `x` at
     /// dyadic thresholds, exactly, so the box test gives the descent's answer bit for bit.

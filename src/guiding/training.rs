@@ -13,6 +13,7 @@
 use super::{
     DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint,
 };
+use crate::math::mix64;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -27,6 +28,8 @@ const ENERGY_THRESHOLD: f64 = 0.01;
 /// map back into the neighbouring leaf and be given that leaf's density. The deeper the leaf, the larger that
 /// share: ~2·10⁻⁴ of draws at depth 10 (measured by `tests/guided.rs`), ~10⁻² it would be at depth 16.
 const MAX_DTREE_DEPTH: usize = 12;
+/// Samples a leaf scores its mixture weights on, about, at most.
+const SCORED: u64 = 2048;
 /// Spatial tree levels at most.
 const MAX_STREE_DEPTH: usize = 30;
 
@@ -77,12 +80,31 @@ pub struct Found {
     pub at: Vec3,
 }
 
-/// A record that found light as its leaf's quadtree took it: square point, value, distance from the anchor.
+/// A record that found light as its leaf's quadtree took it: square point, value, distance from the anchor; for a
+/// sample of `guided`, what scores the mixture weights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Lit {
     square: Vec2,
     value: f32,
     distance: Option<f32>,
+    scored: Option<Scored>,
+}
+
+/// A sample of `guided` that found light, as the weights score it against the guide built from its iteration:
+/// its point and direction (for the new guide's density there), and its [`MixtureSample`] (whose guide part was
+/// the old guide's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Scored {
+    from: Vec3,
+    wi: Vec3,
+    sample: MixtureSample,
+}
+
+impl Scored {
+    /// A hash of its point and direction (which of a leaf's samples are scored).
+    fn hash(&self) -> u64 {
+        [self.from, self.wi].iter().flat_map(|v| v.to_array()).fold(0, |h, x| mix64(h ^ x.to_bits() as u64))
+    }
 }
 
 /// What one iteration built.
@@ -150,8 +172,6 @@ pub struct Training {
     guide: Arc<Guide>,
     /// Per leaf of the guide's spatial tree: the records of the current iteration.
     sums: Vec<Sums>,
-    /// Per leaf: the mixture weights' candidates scored on the current iteration's samples.
-    moments: Vec<Moments>,
     /// Per leaf: where the current iteration's rays converge.
     foci: Vec<FocusMoments>,
     /// Per leaf: the current iteration's records that found light, as recorded (recorded again at the build,
@@ -181,11 +201,10 @@ impl Training {
 
     fn from_guide(guide: Arc<Guide>, settings: GuideSettings) -> Self {
         let sums = guide.dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
-        let moments = vec![Moments::default(); guide.dtrees.len()];
         let foci = vec![FocusMoments::default(); guide.dtrees.len()];
         let lit = vec![Vec::new(); guide.dtrees.len()];
         let (iteration, next, log, learning) = (0, 0, Vec::new(), Duration::ZERO);
-        Self { settings, guide, sums, moments, foci, lit, iteration, next, log, learning, kept: false }
+        Self { settings, guide, sums, foci, lit, iteration, next, log, learning, kept: false }
     }
 
     /// A guide learned earlier (e.g. kept across a camera change), used as it is: it learns no more.
@@ -241,7 +260,6 @@ impl Training {
         if first != self.next {
             // A restart or a gap: this iteration's records start again from its first sample.
             self.sums.iter_mut().for_each(|s| *s = Sums::new(s.shape().clone()));
-            self.moments.iter_mut().for_each(|m| *m = Moments::default());
             self.foci.iter_mut().for_each(|m| *m = FocusMoments::default());
             self.lit.iter_mut().for_each(Vec::clear);
             self.next = samples.start;
@@ -268,9 +286,8 @@ impl Training {
             }
         }
         let (centres, foci) = (&self.guide.centres, &self.guide.foci);
-        let leaves = self.sums.par_iter_mut().zip(self.moments.par_iter_mut()).zip(self.foci.par_iter_mut());
-        let leaves = leaves.zip(self.lit.par_iter_mut()).zip(by_leaf).enumerate();
-        leaves.for_each(|(leaf, ((((sums, moments), focus), lit), records))| {
+        let leaves = self.sums.par_iter_mut().zip(self.foci.par_iter_mut()).zip(self.lit.par_iter_mut());
+        leaves.zip(by_leaf).enumerate().for_each(|(leaf, (((sums, focus), lit), records))| {
             let (c, f) = (centres[leaf], foci[leaf]);
             for r in records {
                 match r.found {
@@ -280,15 +297,14 @@ impl Training {
                             Some((d, distance)) => (d, Some(distance)),
                             None => ((at - from).normalize_or(Vec3::Z), None),
                         };
-                        let record = Lit { square: dir_to_square(d), value, distance };
+                        let wi = (at - from).normalize_or(Vec3::Z);
+                        let scored = r.mixture.map(|sample| Scored { from, wi, sample });
+                        let record = Lit { square: dir_to_square(d), value, distance, scored };
                         sums.record(record.square, value);
                         lit.push(record);
                         focus.record(from - c, at - c, value);
                     }
                     None => sums.record_empty(),
-                }
-                if let Some(m) = &r.mixture {
-                    moments.record(m);
                 }
             }
         });
@@ -307,26 +323,34 @@ impl Training {
         // iteration's light fell elsewhere (a focus that moved, a leaf just split whose anchor moved) they hold it
         // in coarse cells. They only shape the quadtree the records then go into, filtered: refined where the light
         // fell, it resolves the light as finely wherever it is.
+        // The weights are scored against the guide just built (its density at each sample's direction), on the
+        // samples it was built from: E_c[X²] = E_old[g² / (p_c p_old)] holds for any new density in p_c.
         let sums = self.sums.par_iter().zip(&self.lit);
-        let densities: Vec<DTree> = sums
+        let (densities, moments): (Vec<DTree>, Vec<Moments>) = sums
             .zip(&self.guide.centres)
             .map(|((sums, lit), &c)| {
                 let mut again = Sums::new(sums.density().refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH));
                 lit.iter().for_each(|r| again.record_filtered(r.square, r.value, r.distance));
-                again.density_about(c)
+                let density = again.density_about(c);
+                // At most about SCORED of them (those whose hash falls on a multiple of the stride: the same set in
+                // any order): a few thousand samples choose among the candidates as well as millions would.
+                let scored = lit.iter().filter_map(|r| r.scored.as_ref());
+                let stride = (scored.clone().count() as u64).div_ceil(SCORED).max(1);
+                let mut moments = Moments::default();
+                for s in scored.filter(|s| s.hash() % stride == 0) {
+                    let [_, light, brdf] = s.sample.parts;
+                    moments.record(&MixtureSample { parts: [density.pdf_at(s.from, s.wi), light, brdf], ..s.sample });
+                }
+                (density, moments)
             })
-            .collect();
+            .unzip();
         let (mut weight_sum, mut lit_leaves) = ([0.0f32; 3], 0);
         let counts: Vec<u64> = self.sums.iter().map(|s| s.records).collect();
         let mut stree: STree = self.guide.stree.clone();
         let threshold = self.settings.spatial_threshold as f64 * (self.iteration as f64).exp2().sqrt();
         let parents = stree.split(&counts, threshold, MAX_STREE_DEPTH);
         let dtrees: Vec<DTree> = parents.iter().map(|&p| densities[p as usize].clone()).collect();
-        // Weights are scored from the first iteration on. Where no guide was there, its density was 0 in every
-        // sample, so a candidate with c_g > 0 scores worse than its c_g = 0 counterpart and light and BRDF share the
-        // samples: the next iteration scores the new guide (its density at each direction is recorded whatever its
-        // weight) before the one after samples from it.
-        let weights = parents.iter().map(|&p| self.moments[p as usize].best()).collect::<Vec<_>>();
+        let weights = parents.iter().map(|&p| moments[p as usize].best()).collect::<Vec<_>>();
         let foci = parents.iter().map(|&p| self.foci[p as usize].fraction()).collect::<Vec<_>>();
         for (w, &p) in weights.iter().zip(&parents) {
             if self.sums[p as usize].records > 0 {
@@ -335,7 +359,6 @@ impl Training {
             }
         }
         self.sums = dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
-        self.moments = vec![Moments::default(); dtrees.len()];
         self.foci = vec![FocusMoments::default(); dtrees.len()];
         self.lit = vec![Vec::new(); dtrees.len()];
         let centres = stree.leaf_centres();

@@ -8,7 +8,7 @@ use super::lanes::{
 use super::sink::{Census, Learner};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
-use crate::guiding::{Guide, GuideRecord, GuideSettings, Training};
+use crate::guiding::{Guide, GuideRecord, GuideSettings, LeafHint, Training};
 use crate::math::{PixelStreams, SampleRng};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
 use cpu_time::ThreadTime;
@@ -240,6 +240,7 @@ impl Renderer {
                 let mut rays = 0;
                 let streams = |x: usize| PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
                 if count < GROUP_MIN_SAMPLES {
+                    let mut leaf = None;
                     for (x, acc) in row.iter_mut().enumerate() {
                         let streams = streams(x);
                         for s in first..first + count {
@@ -247,7 +248,8 @@ impl Renderer {
                             let (dir, hit) = self.camera_ray(x as u32, y as u32, &mut rng);
                             rays += 1;
                             let learned = learned.as_deref_mut();
-                            add(acc, hit.map_or(Vec3::ZERO, |hit| self.shade(dir, &hit, &mut rng, &mut rays, learned)));
+                            let shade = |hit| self.shade(dir, &hit, &mut rng, &mut rays, learned, &mut leaf);
+                            add(acc, hit.map_or(Vec3::ZERO, shade));
                         }
                     }
                 } else {
@@ -406,16 +408,21 @@ impl Renderer {
                     [a, b] => mis_lanes(&ctx, (&a, &b), lanes),
                 }
             }
-            _ => std::array::from_fn(|l| {
-                hits.lane(l).map_or(Vec3::ZERO, |hit| {
-                    self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays, learned.as_deref_mut())
+            _ => {
+                // The lanes' points mostly share a spatial leaf of the guide: found once, then by a box test.
+                let mut leaf = None;
+                std::array::from_fn(|l| {
+                    hits.lane(l).map_or(Vec3::ZERO, |hit| {
+                        self.shade(dirs.lane(l), &hit, &mut rngs.lane(l), rays, learned.as_deref_mut(), &mut leaf)
+                    })
                 })
-            }),
+            }
         }
     }
 
     /// One sample of `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface x seen along the camera ray `dir`;
-    /// with `learned`, the directions evaluated are recorded there for the guide.
+    /// with `learned`, the directions evaluated are recorded there for the guide (x's spatial leaf found through
+    /// `leaf`, see [`STree::leaf_near`]).
     #[inline]
     fn shade(
         &self,
@@ -424,6 +431,7 @@ impl Renderer {
         rng: &mut SampleRng,
         rays: &mut u64,
         learned: Option<&mut Vec<GuideRecord>>,
+        leaf: &mut Option<LeafHint>,
     ) -> Vec3 {
         let sp = self.shading_point(dir, hit);
         let emitted = self.scene.emitted(hit.triangle, -dir);
@@ -432,8 +440,8 @@ impl Renderer {
             (Some(out), Some(guide)) => {
                 // MIS divides technique i's directions by n_i; one-sample strategies take one (technique 0).
                 let samples = if strategy == Strategy::Mis { ctx.mis.samples } else { [1, 1] };
-                let (_, extent) = guide.stree.leaf_extent(sp.p);
-                let mut learner = Learner { stree: &guide.stree, p: sp.p, extent, samples, out };
+                let (_, extent) = guide.stree.leaf_extent_near(sp.p, leaf);
+                let mut learner = Learner { stree: &guide.stree, home: *leaf, p: sp.p, extent, samples, out };
                 strategy.estimate(&ctx, &sp, rng, rays, &mut learner)
             }
             _ => strategy.estimate(&ctx, &sp, rng, rays, &mut ()),

@@ -4,7 +4,7 @@
 //! sink is a type parameter, so the production path, which passes `()`,
 //! builds no record and pays nothing.
 
-use crate::guiding::{Found, GuideRecord, MixtureSample, STree};
+use crate::guiding::{Found, GuideRecord, LeafHint, MixtureSample, STree};
 use crate::math::{luminance, mix64};
 use glam::Vec3;
 
@@ -145,6 +145,8 @@ impl SampleSink for Census {
 /// converge: [`crate::guiding::Training::learn`]); the others add no energy and only count.
 pub(super) struct Learner<'a> {
     pub(super) stree: &'a STree,
+    /// The leaf holding p (a jittered point in it is found by a box test).
+    pub(super) home: Option<LeafHint>,
     pub(super) p: Vec3,
     /// The size of the box of the leaf holding p.
     pub(super) extent: Vec3,
@@ -168,7 +170,7 @@ impl SampleSink for Learner<'_> {
                 ((bits >> 21) & 0x1f_ffff) as f32,
                 ((bits >> 42) & 0x1f_ffff) as f32,
             ) / (1u32 << 21) as f32;
-            let leaf = self.stree.leaf(self.p + (u - 0.5) * self.extent);
+            let leaf = self.stree.leaf_near(self.p + (u - 0.5) * self.extent, &mut self.home.clone());
             let mixture = (r.parts != [0.0; 3]).then(|| MixtureSample {
                 contribution: luminance(r.contribution),
                 pdf: r.pdf,
