@@ -7,6 +7,7 @@
 //! bit, so a film does not depend on how its samples were grouped.
 
 use super::estimator::{unshadowed, visible_lanes};
+use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, SampleContext, Technique};
 use super::{ShadingPoint, Target};
 use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
@@ -153,7 +154,9 @@ pub fn estimate_one_sample_lanes(
                 reflected[l] = value / s.pdf;
                 shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
             }
-            Target::Trace => traced.add(l, &sp, s, rays),
+            Target::Trace => {
+                let _ = traced.add(l, &sp, s, rays);
+            }
         }
     }
     let visible = shadow_rays.trace(scene, rays);
@@ -271,7 +274,7 @@ pub fn estimate_mis_lanes(
         let Some(sp) = &shading[l] else { continue };
         let Some(s) = brdf.sample(&contexts[1], sp, &mut rngs[l]) else { continue };
         if let Target::Trace = s.target {
-            traced.add(l, sp, s, rays);
+            let _ = traced.add(l, sp, s, rays);
         } else if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
             let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
             from_brdf[l] = value * (w / (1.0 * s.pdf));
@@ -305,13 +308,15 @@ struct TracedRays {
 impl TracedRays {
     /// Lane `l`'s direction `s` from `sp`, unless it contributes nothing whatever arrives along it (then no ray is
     /// traced, as in `integrand`).
+    /// Why not, where not.
     #[inline(always)]
-    fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) {
-        let Ok((f, cos)) = super::estimator::brdf_and_cos(sp, &s) else { return };
+    fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) -> Result<(), Outcome> {
+        let (f, cos) = super::estimator::brdf_and_cos(sp, &s)?;
         *rays += 1;
         self.rays[l] = (crate::math::offset_ray_origin(sp.p, sp.n, sp.error), s.wi);
         self.pending[l] = Some((s, f, cos));
         self.lanes |= 1 << l;
+        Ok(())
     }
 
     /// Per lane: `f_r L_e (ω·n)` where the ray meets a surface that emits towards it, the emitter triangle and point
@@ -331,10 +336,11 @@ impl TracedRays {
     }
 }
 
-/// [`super::strategy::guided`]'s estimator with a frozen guide for up to eight samples of one pixel, bit for bit:
-/// per lane a direction of the mixture; the directions aimed at a light have their shadow rays traced together,
-/// the others walk the tree together, interleaved; then each value is divided by the mixture's density at its
-/// direction, given the emitter it reached. Adds the rays traced to `rays`.
+/// [`super::strategy::guided`]'s estimator for up to eight samples of one pixel, bit for bit: per lane a
+/// direction of the mixture; the directions aimed at a light have their shadow rays traced together, the others
+/// walk the tree together, interleaved; then each value is divided by the mixture's density at its direction,
+/// given the emitter it reached. With `sink` (a pass that learns), each lane's direction is reported to it as the
+/// estimator reports it, with the lane's shading point. Adds the rays traced to `rays`.
 #[inline]
 pub fn estimate_guided_lanes(
     ctx: &SampleContext,
@@ -342,39 +348,49 @@ pub fn estimate_guided_lanes(
     hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
+    mut sink: Option<&mut dyn FnMut(&ShadingPoint, SampleRecord)>,
 ) -> [Vec3; LANES] {
     use super::strategy::Reached;
     use super::strategy::guided::Drawn;
     let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let (mut shadow_rays, mut traced) = (ShadowRays::default(), TracedRays::default());
-    let mut pending: [Option<(ShadingPoint, Drawn)>; LANES] = std::array::from_fn(|_| None);
+    // Per lane: its point and direction, and what is known before the rays are traced: the unshadowed value of a
+    // light's point, a ray being traced, or why nothing can arrive.
+    let mut drawn: [Option<(ShadingPoint, Drawn, Result<Option<(Vec3, Reached)>, Outcome>)>; LANES] =
+        std::array::from_fn(|_| None);
     let mut leaf = None;
     for l in 0..LANES {
         let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
         emitted[l] = le;
         let Some(d) = Drawn::draw(ctx, &sp, &mut rngs[l], &mut leaf) else { continue };
-        match d.s.target {
-            Target::Emitter { triangle, point } => {
-                if let Ok((value, n_x)) = unshadowed(scene, &sp, &d.s, triangle) {
-                    reflected[l] = d.weighted(ctx, &sp, value, Reached { triangle, point });
-                    shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
-                }
-            }
-            Target::Trace => {
-                traced.add(l, &sp, d.s, rays);
-                pending[l] = Some((sp, d));
-            }
-        }
+        let known = match d.s.target {
+            Target::Emitter { triangle, point } => unshadowed(scene, &sp, &d.s, triangle).map(|(value, n_x)| {
+                shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
+                Some((value, Reached { triangle, point }))
+            }),
+            Target::Trace => traced.add(l, &sp, d.s, rays).map(|()| None),
+        };
+        drawn[l] = Some((sp, d, known));
     }
     let visible = shadow_rays.trace(scene, rays);
-    for (l, found) in traced.trace(scene).into_iter().enumerate() {
-        if let (Some((sp, d)), Some((value, via, _))) = (&pending[l], found) {
-            reflected[l] = d.weighted(ctx, sp, value, via);
-        }
+    let found = traced.trace(scene);
+    for (l, lane) in drawn.iter().enumerate() {
+        let Some((sp, d, known)) = lane else { continue };
+        let result = match *known {
+            Ok(Some(lit)) if visible & (1 << l) != 0 => Ok(lit),
+            Ok(Some(_)) => Err(Outcome::Occluded),
+            Ok(None) => found[l].map(|(value, via, _)| (value, via)).ok_or(Outcome::MissedLights),
+            Err(outcome) => Err(outcome),
+        };
+        reflected[l] = match sink.as_deref_mut() {
+            Some(sink) => {
+                let (contribution, record) = d.record(ctx, sp, result);
+                sink(sp, record);
+                contribution
+            }
+            None => result.map_or(Vec3::ZERO, |(value, via)| d.weighted(ctx, sp, value, via)),
+        };
     }
-    std::array::from_fn(|l| {
-        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
-        emitted[l] + if shadowed { Vec3::ZERO } else { reflected[l] }
-    })
+    std::array::from_fn(|l| emitted[l] + reflected[l])
 }

@@ -5,7 +5,7 @@
 use super::lanes::{
     LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_lanes, estimate_one_sample_lanes,
 };
-use super::sink::{Census, Learner};
+use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::guiding::{Guide, GuideRecord, GuideSettings, LeafHint, Training};
@@ -386,10 +386,22 @@ impl Renderer {
                 let ctx = self.context();
                 estimate_one_sample_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
             }
-            // `guided` with its guide frozen (training passes record every direction one sample at a time).
-            (Strategy::Guided, _) if learned.is_none() => {
+            // `guided`, frozen or learning (a learning pass records every direction at its point's leaf).
+            (Strategy::Guided, _) => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                estimate_guided_lanes(&self.context(), &dirs, &hits, &mut rngs, rays)
+                let ctx = self.context();
+                match (learned, ctx.guide) {
+                    (Some(out), Some(guide)) => {
+                        let mut home = None;
+                        let mut record = |sp: &ShadingPoint, r: SampleRecord| {
+                            let (_, extent) = guide.stree.leaf_extent_near(sp.p, &mut home);
+                            let (stree, p, samples) = (&guide.stree, sp.p, [1, 1]);
+                            Learner { stree, home, p, extent, samples, out: &mut *out }.record(r);
+                        };
+                        estimate_guided_lanes(&ctx, &dirs, &hits, &mut rngs, rays, Some(&mut record))
+                    }
+                    _ => estimate_guided_lanes(&ctx, &dirs, &hits, &mut rngs, rays, None),
+                }
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)

@@ -140,6 +140,36 @@ impl<'a> Drawn<'a> {
     pub(crate) fn weighted(&self, ctx: &SampleContext, sp: &ShadingPoint, value: Vec3, via: Reached) -> Vec3 {
         value / self.m.pdf(&self.m.parts(ctx, sp, self.s.wi, Some(via)))
     }
+
+    /// The estimator's contribution and what it reports, given what ω found: `f_r L_e (ω·n)` and the emitter
+    /// triangle and point it reached, or why nothing arrived.
+    #[inline]
+    pub(crate) fn record(
+        &self,
+        ctx: &SampleContext,
+        sp: &ShadingPoint,
+        found: Result<(Vec3, Reached), Outcome>,
+    ) -> (Vec3, SampleRecord) {
+        let (s, m) = (&self.s, &self.m);
+        let (contribution, parts, radiance, outcome, hit) = match found {
+            Ok((value, via)) => {
+                let parts = m.parts(ctx, sp, s.wi, Some(via));
+                let radiance = ctx.scene.emitted(via.triangle, -s.wi);
+                (value / m.pdf(&parts), parts, radiance, Outcome::Contributed, via.point)
+            }
+            Err(outcome) => {
+                // An occluded or missed direction still tells the guide something: L_i = 0 there.
+                let via = match s.target {
+                    Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
+                    Target::Trace => None,
+                };
+                (Vec3::ZERO, m.parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome, Vec3::ZERO)
+            }
+        };
+        let (wi, pdf, mis_weight) = (s.wi, m.pdf(&parts), 1.0);
+        let record = SampleRecord { technique: 0, wi, pdf, mis_weight, contribution, radiance, outcome, parts, hit };
+        (contribution, record)
+    }
 }
 
 impl DirectionStrategy for Guided {
@@ -182,33 +212,8 @@ impl DirectionStrategy for Guided {
             sink.record(SampleRecord::none(0));
             return Vec3::ZERO;
         };
-        let (contribution, parts, radiance, outcome, hit) = match integrand(ctx.scene, sp, &s, rays) {
-            Ok((value, via)) => {
-                let parts = m.parts(ctx, sp, s.wi, Some(via));
-                let radiance = ctx.scene.emitted(via.triangle, -s.wi);
-                (value / m.pdf(&parts), parts, radiance, Outcome::Contributed, via.point)
-            }
-            Err(outcome) => {
-                // An occluded or missed direction still tells the guide something: L_i = 0 there.
-                let via = match s.target {
-                    Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
-                    Target::Trace => None,
-                };
-                (Vec3::ZERO, m.parts(ctx, sp, s.wi, via), Vec3::ZERO, outcome, Vec3::ZERO)
-            }
-        };
-        let (wi, pdf) = (s.wi, m.pdf(&parts));
-        sink.record(SampleRecord {
-            technique: 0,
-            wi,
-            pdf,
-            mis_weight: 1.0,
-            contribution,
-            radiance,
-            outcome,
-            parts,
-            hit,
-        });
+        let (contribution, record) = Drawn { s, m }.record(ctx, sp, integrand(ctx.scene, sp, &s, rays));
+        sink.record(record);
         contribution
     }
 }
