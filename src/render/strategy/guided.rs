@@ -72,6 +72,20 @@ impl<'a> Mixture<'a> {
         [guide, light, Technique::pdf(&Brdf, ctx, sp, wi, via)]
     }
 
+    /// The mixture's density at `wi`, its parts of weight 0 left out (the same value: they add 0).
+    #[inline]
+    fn weighted_pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
+        let [g, l, b] = self.w;
+        let guide = match self.dtree {
+            Some(d) if g > 0.0 => g * d.pdf_at(sp.p, wi),
+            _ => 0.0,
+        };
+        let light =
+            if l > 0.0 && ctx.emitters.is_some() { l * Technique::pdf(&Emitter, ctx, sp, wi, via) } else { 0.0 };
+        let brdf = if b > 0.0 { b * Technique::pdf(&Brdf, ctx, sp, wi, via) } else { 0.0 };
+        guide + light + brdf
+    }
+
     /// The mixture's density, from its parts'.
     #[inline]
     fn pdf(&self, parts: &[f32; 3]) -> f32 {
@@ -138,7 +152,7 @@ impl<'a> Drawn<'a> {
     /// estimator's contribution.
     #[inline(always)]
     pub(crate) fn weighted(&self, ctx: &SampleContext, sp: &ShadingPoint, value: Vec3, via: Reached) -> Vec3 {
-        value / self.m.pdf(&self.m.parts(ctx, sp, self.s.wi, Some(via)))
+        value / self.m.weighted_pdf(ctx, sp, self.s.wi, Some(via))
     }
 
     /// The estimator's contribution and what it reports, given what ω found: `f_r L_e (ω·n)` and the emitter
