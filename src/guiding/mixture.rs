@@ -7,13 +7,12 @@
 //!
 //! `E_c[X²] = ∫ g² / p_c dω = E_old[ g² / (p_c p_old) ]`,  `p_c = c_g p_guide + c_l p_light + c_b p_brdf`,
 //!
-//! with g = luminance(f_r L_i (ω·n)) and X = g / p_c; the next iteration takes the candidate of least second
-//! moment (so of least variance, the mean being the same for all). Every candidate has c_l + c_b > 0, so the
-//! estimator stays unbiased whichever is chosen. Every sample that found light is scored (in fixed point, so
-//! in any order); with fewer than 64 of them a leaf keeps [`DEFAULT_WEIGHTS`]. Scoring starts at the first
-//! iteration: samples drawn where no guide existed have a guide density of 0, so only candidates with c_g = 0
-//! can win there; the next iteration records the new guide's density at each of its directions (whatever c_g)
-//! and scores it, and the one after samples from the guide if it won.
+//! with g = luminance(f_r L_i (ω·n)) and X = g / p_c; p_guide is the density of the guide built from these same
+//! samples (the identity holds for any p_c), so the weights fit the guide they are sampled with. The next
+//! iteration takes the candidate of least second moment (so of least variance, the mean being the same for
+//! all). Every candidate has c_l + c_b > 0, so the estimator stays unbiased whichever is chosen. Samples that
+//! found light are scored (about 2048 a leaf, in fixed point, so in any order); with fewer than 64 of them a leaf
+//! keeps [`DEFAULT_WEIGHTS`].
 
 /// The weights of the example, before anything is learned: guide, light, BRDF.
 pub const DEFAULT_WEIGHTS: [f32; 3] = [0.5, 0.25, 0.25];

@@ -13,7 +13,7 @@
 use super::{
     DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint,
 };
-use crate::math::mix64;
+use crate::math::hash_ray;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -103,7 +103,7 @@ struct Scored {
 impl Scored {
     /// A hash of its point and direction (which of a leaf's samples are scored).
     fn hash(&self) -> u64 {
-        [self.from, self.wi].iter().flat_map(|v| v.to_array()).fold(0, |h, x| mix64(h ^ x.to_bits() as u64))
+        hash_ray(self.from, self.wi)
     }
 }
 
@@ -292,12 +292,11 @@ impl Training {
             for r in records {
                 match r.found {
                     Some(Found { value, from, at }) => {
-                        let z = from + (at - from) * f;
-                        let (d, distance) = match anchor_direction(c, z) {
-                            Some((d, distance)) => (d, Some(distance)),
-                            None => ((at - from).normalize_or(Vec3::Z), None),
-                        };
                         let wi = (at - from).normalize_or(Vec3::Z);
+                        let (d, distance) = match anchor_direction(c, from + (at - from) * f) {
+                            Some((d, distance)) => (d, Some(distance)),
+                            None => (wi, None),
+                        };
                         let scored = r.mixture.map(|sample| Scored { from, wi, sample });
                         let record = Lit { square: dir_to_square(d), value, distance, scored };
                         sums.record(record.square, value);
@@ -322,9 +321,9 @@ impl Training {
         // The sums were recorded (unfiltered) into a quadtree shaped by the last iteration's light; where this
         // iteration's light fell elsewhere (a focus that moved, a leaf just split whose anchor moved) they hold it
         // in coarse cells. They only shape the quadtree the records then go into, filtered: refined where the light
-        // fell, it resolves the light as finely wherever it is.
-        // The weights are scored against the guide just built (its density at each sample's direction), on the
-        // samples it was built from: E_c[X²] = E_old[g² / (p_c p_old)] holds for any new density in p_c.
+        // fell, it resolves the light as finely wherever it is. The weights are then scored against this new guide
+        // (its density at each sample's direction), on the samples it was built from: E_c[X²] =
+        // E_old[g² / (p_c p_old)] holds for any new density in p_c.
         let sums = self.sums.par_iter().zip(&self.lit);
         let (densities, moments): (Vec<DTree>, Vec<Moments>) = sums
             .zip(&self.guide.centres)

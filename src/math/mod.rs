@@ -14,7 +14,7 @@ pub use frame::Frame;
 pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};
 pub use phong_polygon::phong_polygon_moment;
 pub use polygon::lambert_polygon_irradiance;
-pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes, mix64};
+pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes, hash_ray, mix64};
 pub use vec3x8::Vec3x8;
 
 /// Reflects `w` about the unit normal `n`: ω_r = 2 (n·ω) n − ω (the lecture's mirror direction).

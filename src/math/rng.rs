@@ -1,7 +1,7 @@
 //! Seeded randomness per (seed, pixel, sample index): a render is a function of the scene, the settings and the
 //! seed, whatever the thread count and the order in which passes run.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use wide::f32x8;
 
 /// The largest f32 below one: uniforms live in [0, 1).
@@ -143,6 +143,13 @@ pub fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
+}
+
+/// A hash of a point and a direction (of their coordinates' bits, through [`mix64`]): a random number that
+/// depends on nothing but the ray, for choices that must not depend on the order of the rays.
+#[inline]
+pub fn hash_ray(p: Vec3, wi: Vec3) -> u64 {
+    [p.to_array(), wi.to_array()].as_flattened().iter().fold(0, |h, v| mix64(h ^ v.to_bits() as u64))
 }
 
 #[cfg(test)]

@@ -307,8 +307,7 @@ struct TracedRays {
 
 impl TracedRays {
     /// Lane `l`'s direction `s` from `sp`, unless it contributes nothing whatever arrives along it (then no ray is
-    /// traced, as in `integrand`).
-    /// Why not, where not.
+    /// traced, as in `integrand`, and the reason is returned).
     #[inline(always)]
     fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) -> Result<(), Outcome> {
         let (f, cos) = super::estimator::brdf_and_cos(sp, &s)?;
@@ -336,6 +335,9 @@ impl TracedRays {
     }
 }
 
+/// Where a pass that learns sends each lane's report: with the lane's shading point.
+pub type LaneSink<'a> = dyn FnMut(&ShadingPoint, SampleRecord) + 'a;
+
 /// [`super::strategy::guided`]'s estimator for up to eight samples of one pixel, bit for bit: per lane a
 /// direction of the mixture; the directions aimed at a light have their shadow rays traced together, the others
 /// walk the tree together, interleaved; then each value is divided by the mixture's density at its direction,
@@ -348,17 +350,17 @@ pub fn estimate_guided_lanes(
     hits: &HitLanes,
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
-    mut sink: Option<&mut dyn FnMut(&ShadingPoint, SampleRecord)>,
+    mut sink: Option<&mut LaneSink>,
 ) -> [Vec3; LANES] {
     use super::strategy::Reached;
     use super::strategy::guided::Drawn;
+    /// What a lane knows before the rays are traced: the unshadowed value of a light's point and where it is, a
+    /// ray being traced (`None`), or why nothing can arrive.
+    type Known = Result<Option<(Vec3, Reached)>, Outcome>;
     let scene = ctx.scene;
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let (mut shadow_rays, mut traced) = (ShadowRays::default(), TracedRays::default());
-    // Per lane: its point and direction, and what is known before the rays are traced: the unshadowed value of a
-    // light's point, a ray being traced, or why nothing can arrive.
-    let mut drawn: [Option<(ShadingPoint, Drawn, Result<Option<(Vec3, Reached)>, Outcome>)>; LANES] =
-        std::array::from_fn(|_| None);
+    let mut drawn: [Option<(ShadingPoint, Drawn, Known)>; LANES] = std::array::from_fn(|_| None);
     let mut leaf = None;
     for l in 0..LANES {
         let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };

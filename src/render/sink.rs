@@ -5,7 +5,7 @@
 //! builds no record and pays nothing.
 
 use crate::guiding::{Found, GuideRecord, LeafHint, MixtureSample, STree};
-use crate::math::{luminance, mix64};
+use crate::math::{hash_ray, luminance};
 use glam::Vec3;
 
 /// Why a direction contributed what it did.
@@ -161,10 +161,7 @@ impl SampleSink for Learner<'_> {
         if r.traced() && r.pdf > 0.0 {
             let n = self.samples[(r.technique as usize).min(1)].max(1) as f32;
             let value = r.mis_weight * luminance(r.radiance) / (n * r.pdf);
-            let bits = [self.p.to_array(), r.wi.to_array()]
-                .as_flattened()
-                .iter()
-                .fold(0u64, |h, v| mix64(h ^ v.to_bits() as u64));
+            let bits = hash_ray(self.p, r.wi);
             let u = Vec3::new(
                 (bits & 0x1f_ffff) as f32,
                 ((bits >> 21) & 0x1f_ffff) as f32,

@@ -63,8 +63,8 @@ impl<'a> Mixture<'a> {
         Self { dtree, w }
     }
 
-    /// The densities of the guide, light and BRDF parts at `wi` (the guide's where a guide exists, whatever its
-    /// weight: the weights learn from it).
+    /// The densities of the guide, light and BRDF parts at `wi`, whatever their weights (a sample reports them:
+    /// the weights are scored on the light and BRDF parts').
     #[inline]
     fn parts(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> [f32; 3] {
         let guide = self.dtree.map_or(0.0, |d| d.pdf_at(sp.p, wi));
