@@ -22,7 +22,7 @@
 use glam::{DVec3, Vec3};
 
 /// The focus at least this far along a ray (a nearer one would put the learned points beside the leaf).
-pub const MIN_FOCUS: f32 = 0.125;
+const MIN_FOCUS: f32 = 0.125;
 
 /// Lit records a leaf needs before its focus moves from the light.
 const MIN_RECORDS: u32 = 64;

@@ -26,7 +26,7 @@ mod stree;
 mod training;
 
 pub use dtree::{DTree, Sums, dir_to_square, square_to_dir};
-pub use focus::{FocusMoments, MIN_FOCUS};
+pub use focus::FocusMoments;
 pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
 pub use parallax::{Anchor, anchor_direction};
 pub use shape::Shape;

@@ -167,7 +167,7 @@ impl SampleSink for Learner<'_> {
                 ((bits >> 21) & 0x1f_ffff) as f32,
                 ((bits >> 42) & 0x1f_ffff) as f32,
             ) / (1u32 << 21) as f32;
-            let leaf = self.stree.leaf_near(self.p + (u - 0.5) * self.extent, &mut self.home.clone());
+            let leaf = self.stree.leaf_near(self.p + (u - 0.5) * self.extent, &mut { self.home });
             let mixture = (r.parts != [0.0; 3]).then(|| MixtureSample {
                 contribution: luminance(r.contribution),
                 pdf: r.pdf,

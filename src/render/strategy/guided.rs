@@ -202,13 +202,13 @@ impl DirectionStrategy for Guided {
             Target::Emitter { triangle, point } => Some(Reached { triangle, point }),
             Target::Trace => reached(ctx.scene, sp, s.wi),
         };
-        let pdf = m.pdf(&m.parts(ctx, sp, s.wi, via));
+        let pdf = m.weighted_pdf(ctx, sp, s.wi, via);
         (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { pdf, ..s })
     }
 
     fn pdf(&self, ctx: &SampleContext, sp: &ShadingPoint, wi: Vec3, via: Option<Reached>) -> f32 {
         let m = Mixture::at(ctx, sp);
-        m.pdf(&m.parts(ctx, sp, wi, via))
+        m.weighted_pdf(ctx, sp, wi, via)
     }
 
     /// `f_r L_i (ω·n) / p(ω)` with the mixture's density, found after L_i (the ray the estimator traces anyway
