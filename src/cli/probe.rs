@@ -140,6 +140,25 @@ pub fn probe(args: ProbeArgs) -> Result<()> {
         r.z_score(truth)
     );
     println!("relative variance of one sample σ²/μ² = {:.4}", r.relative_variance(truth));
+    if let Some(guide) = probe.guide() {
+        let leaf = guide.stree.leaf(p.position) as usize;
+        let [g, l, b] = guide.weights[leaf];
+        let d = &guide.dtrees[leaf];
+        let plane = match d.anchor() {
+            Some(a) => format!(
+                "learned through the plane n·q = {:.3} (n = {:.3}), seen from {:.3}",
+                a.normal.as_dvec3().dot(scene.origin + a.centre.as_dvec3()) + a.height as f64,
+                a.normal,
+                scene.origin + a.centre.as_dvec3()
+            ),
+            None => "learned as directions at the shading points".to_string(),
+        };
+        let nodes = d.shape().nodes();
+        println!(
+            "guide here: spatial leaf {leaf}, {nodes} quadtree nodes, weights (guide, light, BRDF) ({g:.2}, {l:.2}, {b:.2})"
+        );
+        println!("            {plane}");
+    }
     let zeros: Vec<String> = r.zero_counts().map(|(o, n)| format!("{} {n}", o.name())).collect();
     println!("zero directions: {}; non-finite samples: {}", zeros.join(", "), r.non_finite);
     if let Some(c) = &report.chi2 {

@@ -14,6 +14,12 @@
 //! no density (`pdf` is 0, `sample` gives `None`): the strategy that uses it then takes no guided samples.
 
 use super::parallax::Anchor;
+
+/// An edge of the light: a quadrant holding more than this share of the refinement threshold is split too where
+/// a sibling holds more than [`EDGE_CONTRAST`] times its energy.
+const EDGE_SHARE: f64 = 1.0 / 16.0;
+/// See [`EDGE_SHARE`].
+const EDGE_CONTRAST: f64 = 4.0;
 use super::shape::{Node, Shape, quadrant};
 use crate::math::SampleRng;
 use glam::{DVec2, Vec2, Vec3};
@@ -50,21 +56,18 @@ fn square_to_dir_f64(s: DVec2) -> Vec3 {
     glam::DVec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta).as_vec3()
 }
 
-/// Sums of recorded values per leaf of a [`Shape`], in fixed point (order-independent), and how many records.
+/// Sums of recorded values per leaf of a [`Shape`], in fixed point (order-independent).
 #[derive(Clone, Debug)]
 pub struct Sums {
     shape: Shape,
     /// Per node, per quadrant (only leaves receive records).
     sums: Vec<[u128; 4]>,
-    pub records: u64,
-    /// Σ value and Σ value · distance over the records that found light at a known distance from the anchor.
-    anchored: [u128; 2],
 }
 
 impl Sums {
     pub fn new(shape: Shape) -> Self {
         let sums = vec![[0; 4]; shape.nodes.len()];
-        Self { shape, sums, records: 0, anchored: [0; 2] }
+        Self { shape, sums }
     }
 
     pub fn shape(&self) -> &Shape {
@@ -76,25 +79,13 @@ impl Sums {
     pub fn record(&mut self, s: Vec2, value: f32) {
         let (node, q) = self.shape.leaf(s);
         self.sums[node][q] = self.sums[node][q].saturating_add(fixed_point(value));
-        self.records += 1;
-    }
-
-    /// Counts a record that found no light.
-    #[inline]
-    pub fn record_empty(&mut self) {
-        self.records += 1;
     }
 
     /// Adds `value` spread evenly over a square as wide as the leaf holding `s`, centred on `s` (Müller et al.
     /// 2019's directional box filter: a record informs the cells around its own, so that few records cover an
     /// opening's directions without holes). The square wraps around in φ and is cut at the poles (the energy
-    /// stays whole). Leaves receive their share of the square's area. A record that found light at `distance`
-    /// from the leaf's anchor (see [`Anchor`]) also adds to the energy-weighted mean distance R.
-    pub fn record_filtered(&mut self, s: Vec2, value: f32, distance: Option<f32>) {
-        if let Some(r) = distance.filter(|r| r.is_finite() && *r > 0.0) {
-            self.anchored[0] = self.anchored[0].saturating_add(fixed_point(value));
-            self.anchored[1] = self.anchored[1].saturating_add(fixed_point(value * r));
-        }
+    /// stays whole). Leaves receive their share of the square's area.
+    pub fn record_filtered(&mut self, s: Vec2, value: f32) {
         let side = self.shape.leaf_side(s) as f64;
         let (lo, hi) = (s.as_dvec2() - side * 0.5, s.as_dvec2() + side * 0.5);
         let (x0, x1) = (lo.x.max(0.0), hi.x.min(1.0));
@@ -106,7 +97,6 @@ impl Sums {
             pieces[1] = (0.0, hi.y - 1.0);
         }
         let area = (x1 - x0) * side;
-        self.records += 1;
         if !(area > 0.0) || !(value > 0.0) {
             return;
         }
@@ -132,15 +122,6 @@ impl Sums {
                 child => self.splat(child as usize, c, half, (lo, hi), density),
             }
         }
-    }
-
-    /// The density the sums describe, its directions seen from `centre` at the records' mean distance (see
-    /// [`Anchor`]; directions at the shading point where no record gave a distance).
-    pub fn density_about(&self, centre: Vec3) -> DTree {
-        let [energy, weighted] = self.anchored;
-        let radius = (weighted as f64 / energy as f64) as f32;
-        let anchor = (energy > 0 && radius.is_finite() && radius > 0.0).then_some(Anchor { centre, radius });
-        DTree { anchor, ..self.density() }
     }
 
     /// The density the sums describe: each node's quadrant energies summed up from its leaves.
@@ -225,6 +206,11 @@ impl DTree {
     /// The same tree with its directions seen from `anchor`.
     pub fn with_anchor(self, anchor: Option<Anchor>) -> Self {
         Self { anchor, ..self }
+    }
+
+    /// Where its directions are seen from, if anywhere but the shading point.
+    pub fn anchor(&self) -> Option<&Anchor> {
+        self.anchor.as_ref()
     }
 
     /// The anchor, where it reaches `p`.
@@ -329,7 +315,11 @@ impl DTree {
     }
 
     /// The shape of the next recording (Müller's refinement): a quadrant holding more than `threshold` of the
-    /// total energy is split into four, down to `max_depth` levels; the rest stay leaves. With no energy, the root.
+    /// total energy is split into four, down to `max_depth` levels; so is one on an edge of the light, holding
+    /// more than [`EDGE_SHARE`] of that and less than 1/[`EDGE_CONTRAST`] of a sibling's energy (a cell the edge
+    /// crosses near its side holds little energy, and its lit sliver would otherwise get as little density as the
+    /// whole cell: each such cell adds about its own solid angle over the light's to the relative variance). The
+    /// rest stay leaves. With no energy, the root.
     pub fn refined_shape(&self, threshold: f64, max_depth: usize) -> Shape {
         let total = self.total();
         let mut shape = Shape::default();
@@ -340,12 +330,14 @@ impl DTree {
         // energy, depth): a quadrant of self that is a leaf spreads its energy evenly over the new quadrants.
         let mut stack = vec![(0usize, Some(0usize), 0.0f64, 1usize)];
         while let Some((new, old, spread, depth)) = stack.pop() {
+            let brightest = old.map_or(spread, |o| self.energy[o].iter().copied().fold(0.0, f64::max));
             for q in 0..4 {
                 let (energy, old_child) = match old {
                     Some(o) => (self.energy[o][q], self.shape.nodes[o].children[q]),
                     None => (spread, 0),
                 };
-                if depth < max_depth && energy > threshold * total {
+                let edge = energy > EDGE_SHARE * threshold * total && brightest > EDGE_CONTRAST * energy;
+                if depth < max_depth && (energy > threshold * total || edge) {
                     let child = shape.nodes.len();
                     shape.nodes.push(Node::default());
                     shape.nodes[new].children[q] = child as u32;
@@ -396,14 +388,14 @@ mod tests {
     fn filtered_records_keep_their_energy() {
         let shape = Shape::uniform(4); // leaves of side 1/8
         let mut sums = Sums::new(shape.clone());
-        sums.record_filtered(Vec2::new(0.5, 0.99), 8.0, None); // straddles φ = 1 and four leaves
+        sums.record_filtered(Vec2::new(0.5, 0.99), 8.0); // straddles φ = 1 and four leaves
         let d = sums.density();
         assert!((d.total() - 8.0).abs() < 1e-9, "{}", d.total());
         let filled = shape.leaves().iter().filter(|(c, side)| d.pdf(square_to_dir(*c + *side * 0.5)) > 0.0).count();
         assert_eq!(filled, 4, "two leaves across cos θ, two across the φ seam");
         // At a pole the square is cut and the energy stays whole.
         let mut sums = Sums::new(shape);
-        sums.record_filtered(Vec2::new(0.01, 0.3), 2.0, None);
+        sums.record_filtered(Vec2::new(0.01, 0.3), 2.0);
         assert!((sums.density().total() - 2.0).abs() < 1e-9);
     }
 
@@ -452,6 +444,30 @@ mod tests {
         // Uniform energy: each level splits while a quadrant holds more than 1%: 4^-1, 4^-2, 4^-3 > 1% > 4^-4.
         let flat = DTree::from_leaf_energies(Shape::default(), |_, _| 1.0).refined_shape(0.01, 20);
         assert_eq!(flat.nodes(), 1 + 4 + 16 + 64);
+    }
+
+    /// A quadrant on an edge of the light (a sibling holds over four times its energy) is split though it holds
+    /// less than the threshold, down to a sixteenth of it; a dim quadrant among equals is not.
+    #[test]
+    fn edges_of_the_light_are_refined() {
+        // A bright quadrant (0.9), an edge (0.03, 3% of the total), two empty ones, at the threshold 5%: the bright
+        // one splits by its energy, the edge by its contrast.
+        let tree = DTree::from_leaf_energies(Shape::default(), |c, _| match (c.x > 0.4, c.y > 0.4) {
+            (false, false) => 0.9,
+            (true, false) => 0.03,
+            _ => 0.0,
+        });
+        let total = tree.total();
+        assert!(0.03 / total < 0.05 && 0.03 / total > EDGE_SHARE * 0.05);
+        let shape = tree.refined_shape(0.05, 1 + 1);
+        let split: Vec<bool> = (0..4).map(|q| shape.nodes[0].children[q] != 0).collect();
+        assert_eq!(split, [true, true, false, false]);
+        // Below the edge share, or without a brighter sibling, it stays a leaf.
+        let dim = DTree::from_leaf_energies(Shape::default(), |c, _| if c.x > 0.4 && c.y < 0.4 { 0.001 } else { 0.9 });
+        let shape = dim.refined_shape(0.05, 2);
+        assert_eq!(shape.nodes[0].children[1], 0, "{:?}", shape.nodes[0]);
+        let even = DTree::from_leaf_energies(Shape::default(), |_, _| 1.0);
+        assert_eq!(even.refined_shape(0.3, 2).nodes(), 1, "no quadrant above 30%, none on an edge");
     }
 
     #[test]

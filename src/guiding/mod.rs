@@ -14,8 +14,9 @@
 //! over directions (a square as wide as the record's quadtree leaf), and each leaf learns its mixture weights
 //! (see [`mixture`]). Each quadtree learns its light as seen from its leaf's centre, so that every point of the
 //! leaf aims at the same points ([`Anchor`]: parallax-aware guiding), and learns them where its rays converge:
-//! at the light, or at the opening the light comes through ([`FocusMoments`]). Written from the papers (whose code
-//! is GPL-3: none is copied). The guide learns light only, so a change of camera or material keeps it.
+//! in the plane of the light, or of the opening the light comes through ([`focal_plane`]), fitted at each build
+//! to the iteration's rays. Written from the papers (whose code is GPL-3: none is copied). The guide learns light
+//! only, so a change of camera or material keeps it.
 
 mod dtree;
 mod focus;
@@ -26,9 +27,9 @@ mod stree;
 mod training;
 
 pub use dtree::{DTree, Sums, dir_to_square, square_to_dir};
-pub use focus::FocusMoments;
+pub use focus::focal_plane;
 pub use mixture::{CANDIDATES, DEFAULT_WEIGHTS, MixtureSample, Moments, candidate};
-pub use parallax::{Anchor, anchor_direction};
+pub use parallax::Anchor;
 pub use shape::Shape;
 pub use stree::{LeafHint, STree};
 pub use training::{Found, GuideRecord, GuideSettings, IterationReport, Training, TrainingStatus};
@@ -45,9 +46,6 @@ pub struct Guide {
     pub weights: Vec<[f32; 3]>,
     /// Per spatial leaf: the centre of its box, the anchor of the quadtree it records into (see [`Anchor`]).
     pub centres: Vec<Vec3>,
-    /// Per spatial leaf: the fraction of the way to the light at which its records' rays are learned (see
-    /// [`FocusMoments`]; 1 for the light itself).
-    pub foci: Vec<f32>,
     /// Which scene's light it learned: [`light_fingerprint`] of that scene.
     pub fingerprint: u64,
 }
@@ -57,8 +55,7 @@ impl Guide {
     pub fn new(stree: STree, dtrees: Vec<DTree>, fingerprint: u64) -> Self {
         let weights = vec![DEFAULT_WEIGHTS; dtrees.len()];
         let centres = stree.leaf_centres();
-        let foci = vec![1.0; dtrees.len()];
-        Self { stree, dtrees, weights, centres, foci, fingerprint }
+        Self { stree, dtrees, weights, centres, fingerprint }
     }
 
     /// A guide with no energy (no density anywhere) over the box `lo..hi`.
@@ -93,7 +90,7 @@ impl Guide {
 
     /// Bytes the guide occupies: the quadtrees, the spatial nodes, and each leaf's weights, anchor and focus.
     pub fn bytes(&self) -> usize {
-        let per_leaf = std::mem::size_of::<[f32; 3]>() + std::mem::size_of::<Vec3>() + std::mem::size_of::<f32>();
+        let per_leaf = std::mem::size_of::<[f32; 3]>() + std::mem::size_of::<Vec3>();
         self.dtrees.iter().map(DTree::bytes).sum::<usize>() + self.stree.nodes() * 8 + self.weights.len() * per_leaf
     }
 

@@ -1,18 +1,17 @@
 //! Learning the guide, iteration by iteration (Müller et al. 2017, §3.4): iteration k takes the samples
 //! `2^k − 1 .. 2^(k+1) − 1` of every pixel (1, 2, 4, … samples per pixel), sampled with the guide built from
-//! iteration k − 1 (none for k = 0), and records each evaluated direction into the sums of a tree shaped by that
-//! guide. At the end of the iteration the sums become the next guide: leaves that received more than
-//! `c √(2^k)` records are split, and each quadtree is refined where a quadrant holds more than 1% of its energy.
-//! Iterations that end within the training budget learn; after them the guide is frozen.
+//! iteration k − 1 (none for k = 0), and keeps each evaluated direction that found light with its spatial leaf.
+//! At the end of the iteration they become the next guide: each leaf fits its focal plane to them and sums them
+//! into a quadtree refined where a quadrant holds more than 1% of its energy (or lies on an edge of the light);
+//! leaves that received more than `c √(2^k)` records are split. Iterations that end within the training budget
+//! learn; after them the guide is frozen.
 //!
 //! A pass is unbiased given the frozen guide it samples from, so every pass may be kept. The guide is a function
-//! of the records only, summed in fixed point: the same for any order, so for any thread count and any split
+//! of the records only, every sum in fixed point: the same for any order, so for any thread count and any split
 //! into passes, provided every sample of an iteration is recorded exactly once. A pass that does not continue
 //! the iteration where the last one stopped (a restart) starts the iteration's records again.
 
-use super::{
-    DTree, FocusMoments, Guide, MixtureSample, Moments, STree, Sums, anchor_direction, dir_to_square, light_fingerprint,
-};
+use super::{Anchor, DTree, Guide, MixtureSample, Moments, STree, Sums, dir_to_square, focal_plane, light_fingerprint};
 use crate::math::hash_ray;
 use crate::scene::Scene;
 use glam::{Vec2, Vec3};
@@ -30,6 +29,8 @@ const ENERGY_THRESHOLD: f64 = 0.01;
 const MAX_DTREE_DEPTH: usize = 12;
 /// Samples a leaf scores its mixture weights on, about, at most.
 const SCORED: u64 = 2048;
+/// Records that found light a leaf fits its focal plane to, about, at most.
+const FITTED: u64 = 4096;
 /// Spatial tree levels at most.
 const MAX_STREE_DEPTH: usize = 30;
 
@@ -80,30 +81,21 @@ pub struct Found {
     pub at: Vec3,
 }
 
-/// A record that found light as its leaf's quadtree took it: square point, value, distance from the anchor; for a
-/// sample of `guided`, what scores the mixture weights.
+/// A record that found light, kept until its iteration's guide is built: its ray from the shading point to the
+/// light, its value, and for a sample of `guided`, what scores the mixture weights (a [`MixtureSample`] whose
+/// guide part was the old guide's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Lit {
-    square: Vec2,
-    value: f32,
-    distance: Option<f32>,
-    scored: Option<Scored>,
-}
-
-/// A sample of `guided` that found light, as the weights score it against the guide built from its iteration:
-/// its point and direction (for the new guide's density there), and its [`MixtureSample`] (whose guide part was
-/// the old guide's).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Scored {
     from: Vec3,
-    wi: Vec3,
-    sample: MixtureSample,
+    at: Vec3,
+    value: f32,
+    mixture: Option<MixtureSample>,
 }
 
-impl Scored {
-    /// A hash of its point and direction (which of a leaf's samples are scored).
-    fn hash(&self) -> u64 {
-        hash_ray(self.from, self.wi)
+impl Lit {
+    /// The ray's direction.
+    fn wi(&self) -> Vec3 {
+        (self.at - self.from).normalize_or(Vec3::Z)
     }
 }
 
@@ -170,12 +162,9 @@ pub struct TrainingStatus {
 pub struct Training {
     settings: GuideSettings,
     guide: Arc<Guide>,
-    /// Per leaf of the guide's spatial tree: the records of the current iteration.
-    sums: Vec<Sums>,
-    /// Per leaf: where the current iteration's rays converge.
-    foci: Vec<FocusMoments>,
-    /// Per leaf: the current iteration's records that found light, as recorded (recorded again at the build,
-    /// into a quadtree refined where they put their energy).
+    /// Per leaf of the guide's spatial tree: how many records the current iteration gave it.
+    records: Vec<u64>,
+    /// Per leaf: the current iteration's records that found light (its quadtree at the build).
     lit: Vec<Vec<Lit>>,
     iteration: u32,
     /// The sample the current iteration's records continue from.
@@ -200,11 +189,9 @@ impl Training {
     }
 
     fn from_guide(guide: Arc<Guide>, settings: GuideSettings) -> Self {
-        let sums = guide.dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
-        let foci = vec![FocusMoments::default(); guide.dtrees.len()];
-        let lit = vec![Vec::new(); guide.dtrees.len()];
+        let (records, lit) = (vec![0; guide.dtrees.len()], vec![Vec::new(); guide.dtrees.len()]);
         let (iteration, next, log, learning) = (0, 0, Vec::new(), Duration::ZERO);
-        Self { settings, guide, sums, foci, lit, iteration, next, log, learning, kept: false }
+        Self { settings, guide, records, lit, iteration, next, log, learning, kept: false }
     }
 
     /// A guide learned earlier (e.g. kept across a camera change), used as it is: it learns no more.
@@ -259,8 +246,7 @@ impl Training {
         let samples = iteration_samples(self.iteration);
         if first != self.next {
             // A restart or a gap: this iteration's records start again from its first sample.
-            self.sums.iter_mut().for_each(|s| *s = Sums::new(s.shape().clone()));
-            self.foci.iter_mut().for_each(|m| *m = FocusMoments::default());
+            self.records.iter_mut().for_each(|n| *n = 0);
             self.lit.iter_mut().for_each(Vec::clear);
             self.next = samples.start;
         }
@@ -274,39 +260,17 @@ impl Training {
     }
 
     /// Takes the records of samples `self.next..until` (a range [`Training::plan`] said to record); builds the
-    /// next guide when they complete the iteration. Leaves take their records in parallel (the sums are exact,
-    /// so the order does not matter). A record that found light goes into its leaf's quadtree as the direction
-    /// from the leaf's anchor toward the point of its ray at the leaf's focus, with that point's distance.
+    /// next guide when they complete the iteration. Each leaf counts its records and keeps those that found light.
     pub fn learn(&mut self, records: impl IntoIterator<Item = GuideRecord>, until: u32) {
         let start = Instant::now();
-        let mut by_leaf: Vec<Vec<GuideRecord>> = vec![Vec::new(); self.sums.len()];
         for r in records {
-            if let Some(bucket) = by_leaf.get_mut(r.leaf as usize) {
-                bucket.push(r);
+            let leaf = r.leaf as usize;
+            let Some(count) = self.records.get_mut(leaf) else { continue };
+            *count += 1;
+            if let Some(Found { value, from, at }) = r.found {
+                self.lit[leaf].push(Lit { from, at, value, mixture: r.mixture });
             }
         }
-        let (centres, foci) = (&self.guide.centres, &self.guide.foci);
-        let leaves = self.sums.par_iter_mut().zip(self.foci.par_iter_mut()).zip(self.lit.par_iter_mut());
-        leaves.zip(by_leaf).enumerate().for_each(|(leaf, (((sums, focus), lit), records))| {
-            let (c, f) = (centres[leaf], foci[leaf]);
-            for r in records {
-                match r.found {
-                    Some(Found { value, from, at }) => {
-                        let wi = (at - from).normalize_or(Vec3::Z);
-                        let (d, distance) = match anchor_direction(c, from + (at - from) * f) {
-                            Some((d, distance)) => (d, Some(distance)),
-                            None => (wi, None),
-                        };
-                        let scored = r.mixture.map(|sample| Scored { from, wi, sample });
-                        let record = Lit { square: dir_to_square(d), value, distance, scored };
-                        sums.record(record.square, value);
-                        lit.push(record);
-                        focus.record(from - c, at - c, value);
-                    }
-                    None => sums.record_empty(),
-                }
-            }
-        });
         self.learning += start.elapsed();
         self.next = until;
         if until == iteration_samples(self.iteration).end {
@@ -317,52 +281,60 @@ impl Training {
     /// The next guide from this iteration's sums.
     fn build(&mut self) {
         let start = Instant::now();
-        let records: u64 = self.sums.iter().map(|s| s.records).sum();
-        // The sums were recorded (unfiltered) into a quadtree shaped by the last iteration's light; where this
-        // iteration's light fell elsewhere (a focus that moved, a leaf just split whose anchor moved) they hold it
-        // in coarse cells. They only shape the quadtree the records then go into, filtered: refined where the light
-        // fell, it resolves the light as finely wherever it is. The weights are then scored against this new guide
-        // (its density at each sample's direction), on the samples it was built from: E_c[X²] =
-        // E_old[g² / (p_c p_old)] holds for any new density in p_c.
-        let sums = self.sums.par_iter().zip(&self.lit);
-        let (densities, moments): (Vec<DTree>, Vec<Moments>) = sums
-            .zip(&self.guide.centres)
-            .map(|((sums, lit), &c)| {
-                let mut again = Sums::new(sums.density().refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH));
-                lit.iter().for_each(|r| again.record_filtered(r.square, r.value, r.distance));
-                let density = again.density_about(c);
+        let records: u64 = self.records.iter().sum();
+        // Each leaf's lit records are learned as its anchor sees them through its focal plane (fitted to them).
+        // They are first recorded unfiltered into the last guide's quadtree refined once, which only shapes the
+        // quadtree they then go into, filtered: refined where the light fell, it resolves the light as finely
+        // wherever it is. The weights are then scored against this new guide (its density at each sample's
+        // direction), on the samples it was built from: E_c[X²] = E_old[g² / (p_c p_old)] holds for any new
+        // density in p_c.
+        let leaves = self.lit.par_iter().zip(&self.guide.dtrees).zip(&self.guide.centres);
+        let (densities, moments): (Vec<DTree>, Vec<Moments>) = leaves
+            .map(|((lit, old), &c)| {
+                // The plane from at most about FITTED of them (chosen by hash, as the scored samples below).
+                let stride = (lit.len() as u64).div_ceil(FITTED).max(1);
+                let fitted = lit.iter().filter(|r| stride == 1 || hash_ray(r.from, r.wi()).is_multiple_of(stride));
+                let plane = focal_plane(fitted.map(|r| (r.from - c, r.at - c, r.value)));
+                let anchor = plane.map(|(normal, height)| Anchor { centre: c, normal, height });
+                let square = |r: &Lit| {
+                    let wi = r.wi();
+                    dir_to_square(anchor.map_or(wi, |a| a.direction_of(r.from, wi)))
+                };
+                let squares: Vec<Vec2> = lit.iter().map(square).collect();
+                let mut shaping = Sums::new(old.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH));
+                squares.iter().zip(lit).for_each(|(&s, r)| shaping.record(s, r.value));
+                let mut again = Sums::new(shaping.density().refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH));
+                squares.iter().zip(lit).for_each(|(&s, r)| again.record_filtered(s, r.value));
+                let density = again.density().with_anchor(anchor);
                 // At most about SCORED of them (those whose hash falls on a multiple of the stride: the same set in
                 // any order): a few thousand samples choose among the candidates as well as millions would.
-                let scored = lit.iter().filter_map(|r| r.scored.as_ref());
+                let scored = lit.iter().filter_map(|r| r.mixture.map(|m| (r.from, r.wi(), m)));
                 let stride = (scored.clone().count() as u64).div_ceil(SCORED).max(1);
                 let mut moments = Moments::default();
-                for s in scored.filter(|s| s.hash() % stride == 0) {
-                    let [_, light, brdf] = s.sample.parts;
-                    moments.record(&MixtureSample { parts: [density.pdf_at(s.from, s.wi), light, brdf], ..s.sample });
+                for (from, wi, sample) in scored.filter(|&(from, wi, _)| hash_ray(from, wi).is_multiple_of(stride)) {
+                    let [_, light, brdf] = sample.parts;
+                    moments.record(&MixtureSample { parts: [density.pdf_at(from, wi), light, brdf], ..sample });
                 }
                 (density, moments)
             })
             .unzip();
         let (mut weight_sum, mut lit_leaves) = ([0.0f32; 3], 0);
-        let counts: Vec<u64> = self.sums.iter().map(|s| s.records).collect();
         let mut stree: STree = self.guide.stree.clone();
         let threshold = self.settings.spatial_threshold as f64 * (self.iteration as f64).exp2().sqrt();
-        let parents = stree.split(&counts, threshold, MAX_STREE_DEPTH);
+        let parents = stree.split(&self.records, threshold, MAX_STREE_DEPTH);
         let dtrees: Vec<DTree> = parents.iter().map(|&p| densities[p as usize].clone()).collect();
         let weights = parents.iter().map(|&p| moments[p as usize].best()).collect::<Vec<_>>();
-        let foci = parents.iter().map(|&p| self.foci[p as usize].fraction()).collect::<Vec<_>>();
         for (w, &p) in weights.iter().zip(&parents) {
-            if self.sums[p as usize].records > 0 {
+            if self.records[p as usize] > 0 {
                 (0..3).for_each(|k| weight_sum[k] += w[k]);
                 lit_leaves += 1;
             }
         }
-        self.sums = dtrees.iter().map(|d| Sums::new(d.refined_shape(ENERGY_THRESHOLD, MAX_DTREE_DEPTH))).collect();
-        self.foci = vec![FocusMoments::default(); dtrees.len()];
+        self.records = vec![0; dtrees.len()];
         self.lit = vec![Vec::new(); dtrees.len()];
         let centres = stree.leaf_centres();
         let fingerprint = self.guide.fingerprint;
-        self.guide = Arc::new(Guide { stree, dtrees, weights, centres, foci, fingerprint });
+        self.guide = Arc::new(Guide { stree, dtrees, weights, centres, fingerprint });
         self.log.push(IterationReport {
             iteration: self.iteration,
             spp: iteration_samples(self.iteration).end,

@@ -98,6 +98,11 @@ impl Probe {
         &self.scene
     }
 
+    /// The guide it probes with, if any.
+    pub fn guide(&self) -> Option<&Guide> {
+        self.guide.as_deref()
+    }
+
     pub fn context(&self) -> SampleContext<'_> {
         let state = self.state.as_deref();
         let guide = self.guide.as_deref();
