@@ -79,11 +79,8 @@ struct FocusMoments {
 }
 
 impl FocusMoments {
-    /// Adds the ray from `x` to `y` (relative to the leaf's anchor) with weight `w` > 0 (others are ignored).
+    /// Adds the ray from `x` to `y` (relative to the leaf's anchor, finite) with weight `w` > 0 (finite).
     fn record(&mut self, x: Vec3, y: Vec3, w: f32) {
-        if !(w > 0.0 && w.is_finite() && x.is_finite() && y.is_finite()) {
-            return;
-        }
         let (x, y, w) = (x.as_dvec3(), y.as_dvec3(), w as f64);
         self.sums.add([w, w * x.x, w * x.y, w * x.z, w * y.x, w * y.y, w * y.z, w * x.dot(x), w * x.dot(y)]);
         self.records += 1;
@@ -268,7 +265,8 @@ mod tests {
     /// Rays from a floor and from a box's side (off the opening's column) through a square opening at height 1 to
     /// a light at 2: the plane is the opening's (within 8°: the normal comes from the points at a single fraction
     /// of the way, which tilt where rays leave from different heights; a plane tilted about the opening's centre
-    /// blurs its edges by the tilt times the opening's half width times the rays' spread of directions); to the light in the open: the light's plane. Too few rays: no plane.
+    /// blurs its edges by the tilt times the opening's half width times the rays' spread of directions); to the
+    /// light in the open: the light's plane. Too few rays: no plane.
     #[test]
     fn the_focal_plane_is_the_openings() {
         let mut state = 11u64;

@@ -92,6 +92,17 @@ struct Lit {
     mixture: Option<MixtureSample>,
 }
 
+/// Every how many of `count` records one is chosen to keep about `at_most` of them.
+fn stride_for(count: usize, at_most: u64) -> u64 {
+    (count as u64).div_ceil(at_most).max(1)
+}
+
+/// Whether the ray from `from` along `wi` is among the one in `stride` chosen by its hash (the same set in any
+/// order).
+fn chosen(from: Vec3, wi: Vec3, stride: u64) -> bool {
+    stride == 1 || hash_ray(from, wi).is_multiple_of(stride)
+}
+
 impl Lit {
     /// The ray's direction.
     fn wi(&self) -> Vec3 {
@@ -292,8 +303,8 @@ impl Training {
         let (densities, moments): (Vec<DTree>, Vec<Moments>) = leaves
             .map(|((lit, old), &c)| {
                 // The plane from at most about FITTED of them (chosen by hash, as the scored samples below).
-                let stride = (lit.len() as u64).div_ceil(FITTED).max(1);
-                let fitted = lit.iter().filter(|r| stride == 1 || hash_ray(r.from, r.wi()).is_multiple_of(stride));
+                let stride = stride_for(lit.len(), FITTED);
+                let fitted = lit.iter().filter(|r| chosen(r.from, r.wi(), stride));
                 let plane = focal_plane(fitted.map(|r| (r.from - c, r.at - c, r.value)));
                 let anchor = plane.map(|(normal, height)| Anchor { centre: c, normal, height });
                 let square = |r: &Lit| {
@@ -309,9 +320,9 @@ impl Training {
                 // At most about SCORED of them (those whose hash falls on a multiple of the stride: the same set in
                 // any order): a few thousand samples choose among the candidates as well as millions would.
                 let scored = lit.iter().filter_map(|r| r.mixture.map(|m| (r.from, r.wi(), m)));
-                let stride = (scored.clone().count() as u64).div_ceil(SCORED).max(1);
+                let stride = stride_for(scored.clone().count(), SCORED);
                 let mut moments = Moments::default();
-                for (from, wi, sample) in scored.filter(|&(from, wi, _)| hash_ray(from, wi).is_multiple_of(stride)) {
+                for (from, wi, sample) in scored.filter(|&(from, wi, _)| chosen(from, wi, stride)) {
                     let [_, light, brdf] = sample.parts;
                     moments.record(&MixtureSample { parts: [density.pdf_at(from, wi), light, brdf], ..sample });
                 }
