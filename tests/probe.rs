@@ -225,8 +225,25 @@ fn reported_densities_are_the_pdf_and_integrate_to_the_coverage() {
                         strategy.name(),
                         s.pdf
                     );
-                    if strategy.domain() == Domain::Lights {
-                        assert!(density(&ctx, &sp, strategy, s.wi) >= s.pdf * (1.0 - 1e-4));
+                    // The density sums over the light triangles the ray along ω meets. Where ω grazes the sampled
+                    // triangle (cos θ_Δ < 0.01), ω's rounding in f32 moves the crossing by a hundred times more
+                    // than it moves ω, and a point drawn near an edge can be missed: those draws are left out.
+                    let grazing = match s.target {
+                        Target::Emitter { triangle, .. } => {
+                            probe.scene().triangles[triangle as usize].n.dot(-s.wi).abs() < 0.01
+                        }
+                        Target::Trace => false,
+                    };
+                    if strategy.domain() == Domain::Lights && !grazing {
+                        let d = density(&ctx, &sp, strategy, s.wi);
+                        assert!(
+                            d >= s.pdf * (1.0 - 1e-4),
+                            "{} {kind} {}: sampled {:?} at {} against the density {d} over the sphere",
+                            b.name,
+                            strategy.name(),
+                            s.target,
+                            s.pdf
+                        );
                     }
                 }
                 let c = chi_square(&ctx, &sp, strategy, 20_000, 9);

@@ -51,6 +51,15 @@ impl SampleRng {
     pub fn uniform_2d(&mut self) -> Vec2 {
         Vec2::new(self.uniform(), self.uniform())
     }
+
+    /// The stream after `n` more uniforms.
+    #[inline]
+    pub fn after_uniforms(mut self, n: usize) -> Self {
+        for _ in 0..n {
+            self.next_u32();
+        }
+        self
+    }
 }
 
 /// Eight [`SampleRng`] streams, one per SIMD lane, drawn together: the same numbers as each stream alone, from
@@ -155,6 +164,18 @@ pub fn hash_ray(p: Vec3, wi: Vec3) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_stream_after_n_uniforms_goes_on_as_the_stream_that_drew_them() {
+        for n in 0..5 {
+            let mut drawn = SampleRng::new(3, 17, 5);
+            for _ in 0..n {
+                drawn.uniform();
+            }
+            let mut skipped = SampleRng::new(3, 17, 5).after_uniforms(n);
+            assert!((0..4).all(|_| drawn.uniform().to_bits() == skipped.uniform().to_bits()), "n = {n}");
+        }
+    }
 
     #[test]
     fn streams_are_reproducible_and_distinct() {

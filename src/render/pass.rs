@@ -3,7 +3,8 @@
 //! number of threads and any split into passes.
 
 use super::lanes::{
-    LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_lanes, estimate_one_sample_lanes,
+    LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_emitter_brdf_lanes, estimate_mis_lanes,
+    estimate_one_sample_lanes,
 };
 use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
@@ -402,6 +403,14 @@ impl Renderer {
                     }
                     _ => estimate_guided_lanes(&ctx, &dirs, &hits, &mut rngs, rays, None),
                 }
+            }
+            // The default MIS (emitter and BRDF sampling, a direction each): the light directions in f32x8.
+            (Strategy::Mis, Some(emitters))
+                if learned.is_none()
+                    && self.settings.mis.samples == [1, 1]
+                    && self.settings.mis.techniques == [Strategy::Emitter, Strategy::Brdf] =>
+            {
+                estimate_mis_emitter_brdf_lanes(&self.context(), emitters, &dirs, &hits, &mut rngs, rays)
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)

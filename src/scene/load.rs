@@ -281,6 +281,8 @@ impl Meshes {
         let (centre, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
         let origin = if centre.is_finite() && centre.length() > 16.0 * radius.max(1e-3) { centre } else { DVec3::ZERO };
         let positions: Vec<[Vec3; 3]> = self.positions.iter().map(|t| t.map(|v| (v - origin).as_vec3())).collect();
+        // The f64 positions (72 bytes a triangle) are not needed while the tree is built.
+        drop(self.positions);
         let mut scene =
             Scene::new(name, camera.local(origin), &positions, &self.material_ids, self.materials, self.names)
                 .map_err(|e| match e {

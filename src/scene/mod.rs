@@ -27,6 +27,7 @@ pub use material::Material;
 
 use crate::math::SurfaceError;
 use glam::Vec3;
+use std::borrow::Cow;
 
 /// A triangle with its unit geometric normal `n = normalize((v₁−v₀)×(v₂−v₀))` (counter-clockwise winding) and
 /// area. Emitters emit on the side `n` faces; other surfaces are two-sided.
@@ -94,9 +95,8 @@ impl Scene {
                 ));
             }
         }
-        let mut kept = Vec::with_capacity(positions.len());
-        let mut kept_ids = Vec::with_capacity(positions.len());
-        for (tri, &m) in positions.iter().zip(material_ids) {
+        let mut degenerate = Vec::new();
+        for (i, (tri, &m)) in positions.iter().zip(material_ids).enumerate() {
             if tri.iter().any(|v| !v.is_finite()) {
                 return Err(SceneError::NonFinite("vertex position".into()));
             }
@@ -104,22 +104,34 @@ impl Scene {
                 return Err(SceneError::Invalid(format!("triangle uses material {m}, which does not exist")));
             }
             let cross = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
-            if cross.length_squared() > 0.0 && cross.length_squared().is_finite() {
-                kept.push(*tri);
-                kept_ids.push(m);
+            if !(cross.length_squared() > 0.0 && cross.length_squared().is_finite()) {
+                degenerate.push(i);
             }
         }
-        let dropped = positions.len() - kept.len();
-        if dropped > 0 {
-            warnings.push(format!("{dropped} degenerate (zero-area) triangle(s) ignored"));
+        // The triangles kept: all of them (not copied) unless some are degenerate.
+        let (kept, kept_ids): (Cow<[[Vec3; 3]]>, Cow<[u32]>) = if degenerate.is_empty() {
+            (Cow::Borrowed(positions), Cow::Borrowed(material_ids))
+        } else {
+            let keep = |i: &usize| degenerate.binary_search(i).is_err();
+            (
+                (0..positions.len()).filter(keep).map(|i| positions[i]).collect(),
+                (0..positions.len()).filter(keep).map(|i| material_ids[i]).collect(),
+            )
+        };
+        if !degenerate.is_empty() {
+            warnings.push(format!("{} degenerate (zero-area) triangle(s) ignored", degenerate.len()));
         }
         let groups = convex::convex_emitter_groups(&kept, |i| materials[kept_ids[i] as usize].is_emissive());
-        let (accel, order) = Accel::build(&kept, &groups);
+        // The tree is built on one core; each triangle's normal, area and error bounds are worked out meanwhile on
+        // another, in input order, then put in the tree's order.
+        let ((accel, order), unordered) = rayon::join(
+            || Accel::build(&kept, &groups),
+            || kept.iter().zip(kept_ids.iter()).map(|(&tri, &m)| Triangle::new(tri, m)).collect::<Vec<_>>(),
+        );
         // Only groups that some subtree holds apart spare a shadow ray any work.
         let apart = accel.groups_held_apart();
         let convex_groups = order.iter().map(|&i| groups[i as usize].filter(|g| apart.contains(g))).collect();
-        let triangles: Vec<Triangle> =
-            order.iter().map(|&i| Triangle::new(kept[i as usize], kept_ids[i as usize])).collect();
+        let triangles: Vec<Triangle> = order.iter().map(|&i| unordered[i as usize]).collect();
         let emitters: Vec<u32> = (0..triangles.len() as u32)
             .filter(|&i| materials[triangles[i as usize].material as usize].is_emissive())
             .collect();

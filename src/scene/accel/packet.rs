@@ -31,6 +31,7 @@ pub(super) struct TrianglePacket {
 
 impl TrianglePacket {
     /// Up to eight triangles, with their ids.
+    #[cfg(test)]
     pub fn new(triangles: &[([Vec3; 3], u32)]) -> Self {
         Self::from_fn(triangles.len(), |i| triangles[i])
     }

@@ -1,130 +1,24 @@
-//! Light sampling for up to eight samples of one pixel at once, one per SIMD lane. The shadow rays of all lanes
-//! are offset together and walk the BVH together (`Accel::occluded_lanes`). For emitter sampling, the chain of
-//! dependent square roots and divisions each sample needs (hit point, point on the light, distance, ω, density)
-//! also runs in f32x8; what differs per lane in kind (light selection, the material's BRDF) runs in loops over
-//! independent lanes, which the processor overlaps. The other light techniques sample lane by lane. Every lane
-//! computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit for
-//! bit, so a film does not depend on how its samples were grouped.
+//! Up to eight samples of one pixel at once, one per SIMD lane. The shadow rays of all lanes are offset together
+//! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk it interleaved. Emitter sampling,
+//! alone or as MIS's light technique, runs in f32x8 ([`emitter`]); the other techniques sample lane by lane.
+//! Every lane computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit
+//! for bit, so a film does not depend on how its samples were grouped.
+
+mod emitter;
+
+pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
 
 use super::estimator::{unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
-use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, SKIP_NONE, Scene};
+use crate::math::{SampleRng, SurfaceError, Vec3x8};
+use crate::scene::{HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
-use wide::{CmpGt, CmpLt, f32x8};
+use wide::f32x8;
 
 /// Samples per group.
 pub const LANES: usize = 8;
-
-/// `L_e(x, ω_o) + f_r L_i (ω·n) / p(ω)` for up to eight camera rays `dirs` of one pixel and their hits (none
-/// in a lane that missed or is unused), with ω from emitter sampling. Lane l of `rngs` continues sample l's
-/// stream after the camera's two uniforms. Adds the shadow rays traced to `rays`.
-#[inline]
-pub fn estimate_emitter_lanes(
-    scene: &Scene,
-    emitters: &EmitterSampler,
-    dirs: &Vec3x8,
-    hits: &HitLanes,
-    rngs: &mut SampleRngLanes,
-    rays: &mut u64,
-) -> [Vec3; LANES] {
-    // The lanes are visited through the bits of masks such as `hit_lanes`: whether a lane goes on varies from
-    // sample to sample (half of veach-mis's samples pick the back of a sphere), and a branch per lane would be
-    // mispredicted.
-    let hit_lanes = hits.mask;
-    // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir. Each
-    // lane's triangle as two rows of eight, transposed into one vector per component; (u, v) come as vectors.
-    let mut rows = [[f32x8::ZERO; LANES]; 2];
-    let mut materials = [0; LANES];
-    for_each_lane(hit_lanes, |l| {
-        let tri = &scene.triangles[hits.triangle[l] as usize];
-        let (c, n) = (tri.v[2], tri.n);
-        rows[0][l] = Vec3x8::triangle_row(tri.v);
-        rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, tri.error.at_point, 0.0, 0.0, 0.0]);
-        materials[l] = tri.material;
-    });
-    let [cz, nx, ny, nz, p_error, _, _, _] = f32x8::transpose(rows[1]);
-    let [a, b, c] = Vec3x8::triangles(rows[0], cz);
-    let (u, v) = (hits.u, hits.v);
-    let p = a + (b - a) * u + (c - a) * v;
-    let wo = -*dirs;
-    let geometric = Vec3x8::new(nx, ny, nz);
-    let facing = geometric.dot(wo);
-    let n = Vec3x8::select(facing.cmp_lt(f32x8::ZERO), -geometric, geometric);
-    let front = facing.cmp_gt(f32x8::ZERO).move_mask() as u32;
-
-    // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
-    // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
-    // The records are read once every lane has picked, so that their loads wait on the alias table together.
-    let none = EmitterTriangle::NONE.rows();
-    let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
-    let mut light_error = [EmitterTriangle::NONE.error; LANES];
-    // Every lane draws the light's uniform and the point's two, used or not: whether p faces Δ is tested for all
-    // lanes below (`faces`), and a lane that does not, or that picked no light, or missed, reads none of them
-    // after the one-sample estimator would have stopped.
-    let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
-    let mut picked_lanes = 0;
-    if let Some(records) = emitters.pick_fixed_lanes(u_light) {
-        for_each_lane(hit_lanes, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
-        picked_lanes = hit_lanes;
-    } else {
-        for_each_lane(hit_lanes, |l| {
-            if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
-                let record = EmitterTriangle::of(scene, t, p_delta);
-                ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
-                picked_lanes |= 1 << l;
-            }
-        });
-    }
-    let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
-    let [la, lb, lc] = Vec3x8::triangles(lo, cz);
-    let ln = Vec3x8::new(nx, ny, nz);
-    // The picked triangle's material (u32::MAX for none) and convex emitter group.
-    let light_material = material.to_array().map(f32::to_bits);
-    let light_group = group.to_array().map(f32::to_bits);
-    // sample_uniform_triangle, then the density p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|), as `emitter::sample` computes them.
-    let su0 = u_point[0].sqrt();
-    let b0 = f32x8::ONE - su0;
-    let b1 = u_point[1] * su0;
-    let x = la * b0 + lb * b1 + lc * (f32x8::ONE - b0 - b1);
-    let d = x - p;
-    let dist = d.length();
-    let wi = d / dist;
-    let cos_light = ln.dot(-wi);
-    let pdf = p_delta * (dist * dist / (area * cos_light));
-    let cos = n.dot(wi);
-    // `faces`: p on the emitting side of Δ's plane (else L_i = 0, the back of a one-sided emitter).
-    let faces = ln.dot(p - la).cmp_gt(f32x8::ZERO);
-    let ok = faces
-        & dist.cmp_gt(f32x8::ZERO)
-        & cos_light.cmp_gt(f32x8::ZERO)
-        & pdf.cmp_gt(f32x8::ZERO)
-        & pdf.is_finite()
-        & cos.cmp_gt(f32x8::ZERO);
-    let ok = ok.move_mask() as u32;
-
-    let (pdf, cos) = (pdf.to_array(), cos.to_array());
-
-    // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
-    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    for_each_lane(front & hit_lanes, |l| emitted[l] = scene.materials[materials[l] as usize].emission);
-    let mut shadow_rays = 0;
-    for_each_lane(ok & picked_lanes, |l| {
-        let material = &scene.materials[materials[l] as usize];
-        let wi = wi.lane(l);
-        let f = material.eval_brdf(n.lane(l), wo.lane(l), wi);
-        // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`.
-        let li = scene.materials[light_material[l] as usize].emission;
-        if f != Vec3::ZERO && li != Vec3::ZERO {
-            reflected[l] = f * li * cos[l] / pdf[l];
-            shadow_rays |= 1 << l;
-        }
-    });
-    let visible = visible_lanes(scene, (p, n, p_error), (x, ln), (&light_error, light_group), shadow_rays, rays);
-    std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
-}
 
 /// The one-sample estimator `f_r L_i (ω·n) / p(ω)` of any strategy that draws one direction (the light
 /// strategies but `emitter`'s own SIMD path, and uniform, cosine and BRDF sampling) for up to eight samples of one
