@@ -5,12 +5,12 @@
 //! which the processor overlaps. Each lane computes what the scalar estimator computes, in the same order, bit for
 //! bit.
 
-use super::{LANES, TracedRays, shading_point};
+use super::{LANES, mis_second_technique, mis_sums, shading_point};
 use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
+use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
 use crate::render::strategy::{Brdf, Emitter, SampleContext, Technique};
-use crate::render::{ShadingPoint, Target};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene};
 use glam::Vec3;
 use wide::{CmpGt, CmpLt, f32x8};
@@ -240,28 +240,10 @@ pub fn estimate_mis_emitter_brdf_lanes(
         }
         shading[l] = Some(sp);
     });
-    // The BRDF directions, each drawn after its lane's light direction; those to trace walk the tree together.
-    let mut from_brdf = [Vec3::ZERO; LANES];
-    let mut traced = TracedRays::default();
-    for l in 0..LANES {
-        let Some(sp) = &shading[l] else { continue };
-        let Some(s) = Brdf.sample(&contexts[1], sp, &mut streams[l]) else { continue };
-        debug_assert!(matches!(s.target, Target::Trace), "BRDF sampling traces its directions");
-        let _ = traced.add(l, sp, s, rays);
-    }
-    for (l, found) in traced.trace(scene).into_iter().enumerate() {
-        let (Some(sp), Some((value, via, s))) = (&shading[l], found) else { continue };
-        let w = heuristic.weight(1, s.pdf, 1, Emitter.pdf(&contexts[0], sp, s.wi, Some(via)));
-        from_brdf[l] = value * (w / (1.0 * s.pdf));
-    }
+    // The BRDF directions, each drawn after its lane's light direction.
+    let from_brdf = mis_second_technique(&contexts, (&Emitter, &Brdf), &shading, &mut streams, rays);
     let visible = e.visible(scene, shadow_rays, rays);
-    std::array::from_fn(|l| {
-        let shadowed = shadow_rays & !visible & (1 << l) != 0;
-        let mut total = Vec3::ZERO;
-        total += if shadowed { Vec3::ZERO } else { first[l] };
-        total += from_brdf[l];
-        emitted[l] + total
-    })
+    mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ mod emitter;
 
 pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
 
-use super::estimator::{unshadowed, visible_lanes};
+use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, SampleContext, Technique};
 use super::{ShadingPoint, Target};
@@ -129,7 +129,6 @@ pub fn estimate_mis_lanes(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    use super::estimator::integrand;
     use super::strategy::Reached;
     use super::strategy::mis::technique_context;
     let scene = ctx.scene;
@@ -161,8 +160,26 @@ pub fn estimate_mis_lanes(
         }
         shading[l] = Some(sp);
     }
-    // The BRDF directions, each drawn after its lane's light direction; those to trace walk the tree together.
-    let mut from_brdf = [Vec3::ZERO; LANES];
+    // The BRDF directions, each drawn after its lane's light direction.
+    let from_brdf = mis_second_technique(&contexts, (light, brdf), &shading, rngs, rays);
+    let visible = shadow_rays.trace(scene, rays);
+    mis_sums(&emitted, &first, shadow_rays.lanes & !visible, &from_brdf)
+}
+
+/// MIS's second technique for up to eight lanes, each with its shading point (none where the camera ray missed):
+/// a direction from `brdf` drawn from the lane's stream, weighed against `light`'s density there. The directions to
+/// trace walk the tree together ([`TracedRays`]); any other is looked up alone. Returns each lane's weighted
+/// contribution; adds the rays traced to `rays`.
+#[inline(always)]
+fn mis_second_technique(
+    contexts: &[SampleContext; 2],
+    (light, brdf): (&impl Technique, &impl Technique),
+    shading: &[Option<ShadingPoint>; LANES],
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    let (scene, heuristic) = (contexts[1].scene, contexts[1].mis.heuristic);
+    let mut weighted = [Vec3::ZERO; LANES];
     let mut traced = TracedRays::default();
     for l in 0..LANES {
         let Some(sp) = &shading[l] else { continue };
@@ -171,20 +188,25 @@ pub fn estimate_mis_lanes(
             let _ = traced.add(l, sp, s, rays);
         } else if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
             let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
-            from_brdf[l] = value * (w / (1.0 * s.pdf));
+            weighted[l] = value * (w / (1.0 * s.pdf));
         }
     }
     for (l, found) in traced.trace(scene).into_iter().enumerate() {
         let (Some(sp), Some((value, via, s))) = (&shading[l], found) else { continue };
         let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
-        from_brdf[l] = value * (w / (1.0 * s.pdf));
+        weighted[l] = value * (w / (1.0 * s.pdf));
     }
-    let visible = shadow_rays.trace(scene, rays);
+    weighted
+}
+
+/// Each lane's MIS estimate: the radiance its camera ray sees emitted, plus its first technique's weighted
+/// contribution unless that direction's shadow ray was blocked (bit l of `blocked`), plus its second's.
+#[inline(always)]
+fn mis_sums(emitted: &[Vec3; LANES], first: &[Vec3; LANES], blocked: u32, second: &[Vec3; LANES]) -> [Vec3; LANES] {
     std::array::from_fn(|l| {
-        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
         let mut total = Vec3::ZERO;
-        total += if shadowed { Vec3::ZERO } else { first[l] };
-        total += from_brdf[l];
+        total += if blocked & (1 << l) != 0 { Vec3::ZERO } else { first[l] };
+        total += second[l];
         emitted[l] + total
     })
 }
