@@ -62,14 +62,8 @@ pub(crate) fn integrand(
     match s.target {
         Target::Trace => {
             let (f, cos) = brdf_and_cos(sp, s)?;
-            *rays += 1;
-            let origin = offset_ray_origin(sp.p, sp.n, sp.error);
-            let hit = scene.accel().closest_hit(origin, s.wi, f32::INFINITY).ok_or(Outcome::MissedLights)?;
-            let li = scene.emitted(hit.triangle, -s.wi);
-            if li == Vec3::ZERO {
-                return Err(Outcome::MissedLights);
-            }
-            Ok((f * li * cos, Reached { triangle: hit.triangle, point: scene.hit_point(&hit) }))
+            let (li, via) = lit(scene, sp, s.wi, rays)?;
+            Ok((f * li * cos, via))
         }
         Target::Emitter { triangle, point } => {
             let (value, n_x) = unshadowed(scene, sp, s, triangle)?;
@@ -82,11 +76,32 @@ pub(crate) fn integrand(
 }
 
 /// The emitter triangle the ray from `sp` along `wi` reaches first, and where; `None` where it meets a surface
-/// that does not emit towards it, or nothing.
+/// that does not emit towards it, or nothing. Counts no ray: for densities that depend on what a direction
+/// reaches, outside the estimate's own rays.
 pub fn reached(scene: &Scene, sp: &ShadingPoint, wi: Vec3) -> Option<Reached> {
-    let hit = scene.accel().closest_hit(offset_ray_origin(sp.p, sp.n, sp.error), wi, f32::INFINITY)?;
-    (scene.emitted(hit.triangle, -wi) != Vec3::ZERO)
-        .then(|| Reached { triangle: hit.triangle, point: scene.hit_point(&hit) })
+    lit(scene, sp, wi, &mut 0).ok().map(|(_, via)| via)
+}
+
+/// L_i(ω) along a traced direction ω = `wi` from `sp`, which is L_e(x, −ω) at the first surface x the ray from sp
+/// meets, with the emitter triangle and x; why it is zero. The ray starts off the surface
+/// (`math::offset_ray_origin`); x is looked for among the emitter triangles alone, nearest first
+/// ([`crate::scene::EmitterTree`]), and then a shadow ray from sp to x ([`visible`]) asks whether anything lies
+/// before it: two rays where x emits towards sp, one (in the lights' small tree) where none is met. The nearest of
+/// all triangles gives the same answer but for ties within the shadow ray's offsets. Adds the rays traced.
+#[inline]
+fn lit(scene: &Scene, sp: &ShadingPoint, wi: Vec3, rays: &mut u64) -> Result<(Vec3, Reached), Outcome> {
+    *rays += 1;
+    let origin = offset_ray_origin(sp.p, sp.n, sp.error);
+    let hit = scene.emitter_tree().closest_hit(origin, wi).ok_or(Outcome::MissedLights)?;
+    let li = scene.emitted(hit.triangle, -wi);
+    if li == Vec3::ZERO {
+        return Err(Outcome::MissedLights);
+    }
+    let (triangle, point) = (hit.triangle, scene.hit_point(&hit));
+    if !visible(scene, sp, (triangle, point, scene.triangles[triangle as usize].n), rays) {
+        return Err(Outcome::Occluded);
+    }
+    Ok((li, Reached { triangle, point }))
 }
 
 /// f_r and ω·n for a sampled direction; why not, where the sample contributes nothing whatever arrives along ω

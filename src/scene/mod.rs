@@ -5,6 +5,7 @@ mod accel;
 mod bundled;
 mod camera;
 mod convex;
+mod emitter_tree;
 mod emitters;
 mod error;
 mod file;
@@ -19,6 +20,7 @@ pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
+pub use emitter_tree::EmitterTree;
 pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection};
 pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
@@ -68,6 +70,8 @@ pub struct Scene {
     /// to its bounds' centre before its positions are rounded to f32 (0 for a scene near the origin).
     pub origin: glam::DVec3,
     accel: Accel,
+    /// The emitter triangles' own tree: what a traced direction reaches is looked for there first.
+    emitter_tree: EmitterTree,
     /// Per triangle, its convex emitter group (see `convex`), which the shadow rays towards it may skip.
     convex_groups: Vec<Option<u32>>,
 }
@@ -138,6 +142,7 @@ impl Scene {
         if emitters.is_empty() {
             warnings.push("the scene has no emitter: the image will be black".into());
         }
+        let emitter_tree = EmitterTree::new(&triangles, &emitters);
         Ok(Self {
             name: name.into(),
             camera,
@@ -148,6 +153,7 @@ impl Scene {
             warnings,
             origin: glam::DVec3::ZERO,
             accel,
+            emitter_tree,
             convex_groups,
         })
     }
@@ -155,6 +161,11 @@ impl Scene {
     #[inline]
     pub fn accel(&self) -> &Accel {
         &self.accel
+    }
+
+    #[inline]
+    pub fn emitter_tree(&self) -> &EmitterTree {
+        &self.emitter_tree
     }
 
     /// The convex emitter group of triangle `t`, if any: a shadow ray from in front of t's plane to a point on

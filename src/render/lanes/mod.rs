@@ -12,7 +12,7 @@ use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SurfaceError, Vec3x8};
+use crate::math::{SampleRng, SurfaceError, Vec3x8, for_each_lane};
 use crate::scene::{HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
 use wide::f32x8;
@@ -54,8 +54,8 @@ pub fn estimate_one_sample_lanes(
         }
     }
     let visible = shadow_rays.trace(scene, rays);
-    for (l, found) in traced.trace(scene).into_iter().enumerate() {
-        if let Some((value, _, s)) = found {
+    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
+        if let Ok((value, _, s)) = found {
             reflected[l] = value / s.pdf;
         }
     }
@@ -75,6 +75,9 @@ fn shading_point<'a>(scene: &'a Scene, dirs: &Vec3x8, hits: &HitLanes, l: usize)
     let sp = ShadingPoint::on_triangle(scene.hit_point(&hit), tri, wo, scene.material_of(hit.triangle));
     Some((sp, scene.emitted(hit.triangle, wo)))
 }
+
+/// A shading point as a shadow ray leaves it: p, its normal and the bound of its rounding error.
+type Near = (Vec3, Vec3, f32);
 
 /// The shadow rays of a group's lanes, gathered lane by lane and traced together ([`visible_lanes`]).
 struct ShadowRays {
@@ -97,9 +100,15 @@ impl Default for ShadowRays {
 impl ShadowRays {
     /// Lane `l`'s ray from `sp` to `point` (normal `n_x`) on emitter triangle `triangle`.
     #[inline(always)]
-    fn add(&mut self, l: usize, scene: &Scene, sp: &ShadingPoint, (triangle, point, n_x): (u32, Vec3, Vec3)) {
-        (self.ends[0][l], self.ends[1][l], self.ends[2][l], self.ends[3][l]) = (sp.p, sp.n, point, n_x);
-        (self.p_error[l], self.light_error[l]) = (sp.error, scene.triangles[triangle as usize].error);
+    fn add(&mut self, l: usize, scene: &Scene, sp: &ShadingPoint, to: (u32, Vec3, Vec3)) {
+        self.add_from(l, scene, (sp.p, sp.n, sp.error), to);
+    }
+
+    /// Lane `l`'s ray from p (normal n, rounding error bound `error`) to `point` on emitter triangle `triangle`.
+    #[inline(always)]
+    fn add_from(&mut self, l: usize, scene: &Scene, (p, n, error): Near, (triangle, point, n_x): (u32, Vec3, Vec3)) {
+        (self.ends[0][l], self.ends[1][l], self.ends[2][l], self.ends[3][l]) = (p, n, point, n_x);
+        (self.p_error[l], self.light_error[l]) = (error, scene.triangles[triangle as usize].error);
         self.groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
         self.lanes |= 1 << l;
     }
@@ -191,8 +200,8 @@ fn mis_second_technique(
             weighted[l] = value * (w / (1.0 * s.pdf));
         }
     }
-    for (l, found) in traced.trace(scene).into_iter().enumerate() {
-        let (Some(sp), Some((value, via, s))) = (&shading[l], found) else { continue };
+    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
+        let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
         let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
         weighted[l] = value * (w / (1.0 * s.pdf));
     }
@@ -212,12 +221,14 @@ fn mis_sums(emitted: &[Vec3; LANES], first: &[Vec3; LANES], blocked: u32, second
 }
 
 /// Sampled directions to trace, gathered lane by lane (`integrand`'s first half: f_r and ω·n, the ray's origin off
-/// the surface) and traced together (`Accel::closest_hits`), then looked up as `integrand` looks them up.
+/// the surface) and traced together, then looked up as `estimator::lit` looks them up: the nearest emitter
+/// triangles on the rays (`EmitterTree::closest_hits`), then the shadow rays to those that emit towards their
+/// shading points, together ([`ShadowRays`]).
 #[derive(Default)]
 struct TracedRays {
     rays: [(Vec3, Vec3); LANES],
-    /// Per lane: the direction, f_r and ω·n.
-    pending: [Option<(DirectionSample, Vec3, f32)>; LANES],
+    /// Per lane: the shading point the ray leaves, the direction, f_r and ω·n.
+    pending: [Option<(Near, DirectionSample, Vec3, f32)>; LANES],
     lanes: u32,
 }
 
@@ -229,25 +240,35 @@ impl TracedRays {
         let (f, cos) = super::estimator::brdf_and_cos(sp, &s)?;
         *rays += 1;
         self.rays[l] = (crate::math::offset_ray_origin(sp.p, sp.n, sp.error), s.wi);
-        self.pending[l] = Some((s, f, cos));
+        self.pending[l] = Some(((sp.p, sp.n, sp.error), s, f, cos));
         self.lanes |= 1 << l;
         Ok(())
     }
 
     /// Per lane: `f_r L_e (ω·n)` where the ray meets a surface that emits towards it, the emitter triangle and point
-    /// it reached, and the direction.
+    /// it reached, and the direction; or why nothing arrives. Adds the shadow rays traced to `rays`.
     #[inline(always)]
-    fn trace(&self, scene: &Scene) -> [Option<(Vec3, super::strategy::Reached, DirectionSample)>; LANES] {
-        let found = scene.accel().closest_hits(&self.rays, self.lanes, f32::INFINITY);
-        std::array::from_fn(|l| {
-            let ((s, f, cos), hit) = (self.pending[l]?, found[l]?);
+    fn trace(
+        &self,
+        scene: &Scene,
+        rays: &mut u64,
+    ) -> [Result<(Vec3, super::strategy::Reached, DirectionSample), Outcome>; LANES] {
+        let found = scene.emitter_tree().closest_hits(&self.rays, self.lanes);
+        let mut shadow_rays = ShadowRays::default();
+        let mut lit = [Err(Outcome::MissedLights); LANES];
+        for_each_lane(self.lanes, |l| {
+            let (Some((near, s, f, cos)), Some(hit)) = (self.pending[l], found[l]) else { return };
             let li = scene.emitted(hit.triangle, -s.wi);
             if li == Vec3::ZERO {
-                return None;
+                return;
             }
-            let via = super::strategy::Reached { triangle: hit.triangle, point: scene.hit_point(&hit) };
-            Some((f * li * cos, via, s))
-        })
+            let (triangle, point) = (hit.triangle, scene.hit_point(&hit));
+            shadow_rays.add_from(l, scene, near, (triangle, point, scene.triangles[triangle as usize].n));
+            lit[l] = Ok((f * li * cos, super::strategy::Reached { triangle, point }, s));
+        });
+        let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
+        for_each_lane(blocked, |l| lit[l] = Err(Outcome::Occluded));
+        lit
     }
 }
 
@@ -292,13 +313,13 @@ pub fn estimate_guided_lanes(
         drawn[l] = Some((sp, d, known));
     }
     let visible = shadow_rays.trace(scene, rays);
-    let found = traced.trace(scene);
+    let found = traced.trace(scene, rays);
     for (l, lane) in drawn.iter().enumerate() {
         let Some((sp, d, known)) = lane else { continue };
         let result = match *known {
             Ok(Some(lit)) if visible & (1 << l) != 0 => Ok(lit),
             Ok(Some(_)) => Err(Outcome::Occluded),
-            Ok(None) => found[l].map(|(value, via, _)| (value, via)).ok_or(Outcome::MissedLights),
+            Ok(None) => found[l].map(|(value, via, _)| (value, via)),
             Err(outcome) => Err(outcome),
         };
         reflected[l] = match sink.as_deref_mut() {
