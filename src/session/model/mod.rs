@@ -3,39 +3,22 @@
 //! worker, so no caller can change a setting and forget to render it. The viewer ([`crate::app`]) is a shell over
 //! it; a tour step ([`crate::tour`]) is a function that sets one; tests drive it without egui.
 
+mod history;
+mod probing;
+
+pub use history::series_label;
+pub use probing::ProbeOptions;
+
 use super::probe::{ProbeRequest, ProbeView, ProbeWorker};
 use super::views::View;
 use super::worker::{A, B, Budget, Command, Frame, PassSize, ReferenceStatus, Worker};
-use crate::measure::{ConvergencePoint, Reference, Series, error_vs_reference};
-use crate::probe::{Layers, ProbeSettings};
+use crate::measure::{Reference, Series};
 use crate::render::{Footprint, RenderSettings, Strategy};
 use crate::scene::{Camera, Material, Scene};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
-
-/// What the probe looks at and how hard (the session sends a new request whenever any of it changes).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProbeOptions {
-    /// Re-probe the same pixel when the camera moves (else the point stays where it was picked).
-    pub follow: bool,
-    pub settings: ProbeSettings,
-    pub layers: Layers,
-    /// Also measure every strategy at the point.
-    pub table: bool,
-}
-
-impl Default for ProbeOptions {
-    fn default() -> Self {
-        Self {
-            follow: false,
-            settings: ProbeSettings { keep: 2_000, ..Default::default() },
-            layers: Layers::default(),
-            table: false,
-        }
-    }
-}
 
 /// What [`Session::poll`] found.
 #[derive(Debug, Default)]
@@ -230,26 +213,6 @@ impl Session {
     pub fn restart_latency(&self) -> Option<Duration> {
         self.restart_latency
     }
-    /// The probed pixel, if any.
-    pub fn probe_pixel(&self) -> Option<(u32, u32)> {
-        self.probe_pixel.map(|(p, _)| p)
-    }
-    /// Where the probe's marker goes: the probed pixel, while the camera is the one it was picked with.
-    pub fn probe_marker(&self) -> Option<(u32, u32)> {
-        self.probe_pixel.filter(|(_, c)| *c == self.scene.camera).map(|(p, _)| p)
-    }
-    pub fn probe_options(&self) -> ProbeOptions {
-        self.probe
-    }
-    /// The newest probe answer.
-    pub fn probe_view(&self) -> Option<&ProbeView> {
-        self.probe_view.as_ref()
-    }
-    /// The probe answered the request it is working on now (not an older one).
-    pub fn probe_is_current(&self) -> bool {
-        self.probe_view.as_ref().is_some_and(|v| self.last_request.as_ref() == Some(&v.request))
-    }
-
     /// Both lanes shown (A, and B in compare mode) have frames of their current settings, past the preview, and
     /// are done with `spp` samples per pixel: at `spp`, or under equal time in compare mode, at the CPU time the
     /// first lane to reach `spp` needed (where the worker stops them).
@@ -530,94 +493,4 @@ impl Session {
     pub fn clear_history(&mut self) {
         self.history.clear();
     }
-
-    /// Probes pixel (x, y) of the current camera (`None`: no probe).
-    pub fn set_probe_pixel(&mut self, pixel: Option<(u32, u32)>) {
-        self.probe_pixel = pixel.map(|p| (p, self.scene.camera));
-        self.probe.settings.chi2_samples = 0;
-        if pixel.is_none() {
-            self.probe_view = None;
-            self.last_request = None;
-        }
-    }
-
-    /// What the probe shows and how hard it works; the next [`Session::poll`] sends it.
-    pub fn set_probe_options(&mut self, options: ProbeOptions) {
-        self.probe = options;
-    }
-
-    /// Sends a new probe request when what the probe depends on changed.
-    fn request_probe(&mut self) {
-        let Some((pixel, picked_with)) = self.probe_pixel else { return };
-        if self.probe.follow && picked_with != self.scene.camera {
-            self.probe_pixel = Some((pixel, self.scene.camera));
-        }
-        let camera = self.probe_pixel.map_or(self.scene.camera, |p| p.1);
-        let guide_of = |f: Option<&Arc<Frame>>| f.and_then(|f| f.guide.as_ref()).map(|(_, g)| g.clone());
-        let mut lanes = vec![self.settings];
-        let mut guides = vec![guide_of(self.frames[A].as_ref())];
-        if self.comparing {
-            lanes.push(self.settings_b);
-            guides.push(guide_of(self.frames[B].as_ref()));
-        }
-        let request = ProbeRequest {
-            scene: self.scene.clone(),
-            camera,
-            pixel,
-            lanes,
-            guides,
-            settings: self.probe.settings,
-            layers: self.probe.layers,
-            table: self.probe.table,
-        };
-        if self.last_request.as_ref() != Some(&request) {
-            self.probe_worker.request(request.clone());
-            self.last_request = Some(request);
-        }
-    }
-
-    /// Adds a point to the frame's convergence run (a restarted run starts its series again). B's frames are
-    /// skipped when B runs A's estimator: with common random numbers they are the same run.
-    fn record(&mut self, frame: &Frame) {
-        let Some(reference) = self.reference().cloned() else { return };
-        if frame.preview || frame.spp == 0 || reference.mean.len() != frame.radiance.len() {
-            return;
-        }
-        if frame.lane == B && series_label(&frame.settings) == series_label(&self.settings) {
-            return;
-        }
-        // The estimator's own error: the reference's noise is subtracted, as the bench subtracts it.
-        let metrics = error_vs_reference(&frame.radiance, &reference);
-        let point = ConvergencePoint {
-            spp: frame.spp,
-            seconds: frame.stats.cpu.as_secs_f64(),
-            mse: metrics.estimator_mse(),
-            rel_mse: metrics.estimator_rel_mse(),
-        };
-        let label = series_label(&frame.settings);
-        let i = match self.history.iter().position(|s| s.label == label) {
-            Some(i) => i,
-            None => {
-                self.history.push(Series::new(label));
-                self.history.len() - 1
-            }
-        };
-        let series = &mut self.history[i];
-        if series.last().is_some_and(|p| p.spp >= frame.spp) {
-            series.points.clear();
-        }
-        series.push(point);
-    }
-}
-
-/// How a run is named in the convergence plot: the strategy, and what else distinguishes its estimator.
-pub fn series_label(s: &RenderSettings) -> String {
-    let mut label = s.strategy.name().to_string();
-    if s.strategy == Strategy::Mis {
-        label += &format!(" ({})", s.mis.label());
-    }
-    if s.strategy.samples_lights() || s.strategy == Strategy::Mis {
-        label += &format!(" [{}]", s.light_selection.name());
-    }
-    label
 }
