@@ -1,5 +1,6 @@
 //! Up to eight samples of one pixel at once, one per SIMD lane. The shadow rays of all lanes are offset together
-//! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk it interleaved. Emitter sampling,
+//! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk the emitters' own tree interleaved,
+//! and their shadow rays go together too. Emitter sampling,
 //! alone or as MIS's light technique, runs in f32x8 ([`emitter`]); the other techniques sample lane by lane.
 //! Every lane computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit
 //! for bit, so a film does not depend on how its samples were grouped.

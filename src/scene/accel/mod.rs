@@ -1,5 +1,5 @@
-//! Ray queries for the integrator: the closest hit for camera and BRDF rays, any hit with early exit for shadow
-//! rays. obvhs builds a binary BVH, which is collapsed into an 8-wide one whose nodes test eight child boxes
+//! Ray queries for the integrator: the closest hit for camera rays (and, in the emitters' own tree, for traced
+//! directions: `scene::EmitterTree`), any hit with early exit for shadow rays. obvhs builds a binary BVH, which is collapsed into an 8-wide one whose nodes test eight child boxes
 //! and whose leaves test eight triangles against one ray at once (f32x8): one ray, wide nodes, as in Embree's
 //! BVH8 (Wald et al. 2014). A single ray needs no coherence with others, so every strategy's rays run as fast;
 //! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull.

@@ -65,7 +65,7 @@ impl Accel {
     #[inline]
     pub fn closest_hits(&self, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> [Option<Hit>; 8] {
         let Some(root) = self.root.filter(|_| active != 0) else { return [None; 8] };
-        let active = if root.is_leaf() { active } else { self.entering_root(rays, active, t_max) };
+        let active = if root.is_leaf() { active } else { self.entering_root(root, rays, active, t_max) };
         if active == 0 {
             return [None; 8];
         }
@@ -85,12 +85,12 @@ impl Accel {
         })
     }
 
-    /// The rays of `active` that enter some child of the root node, found for all of them at once, a child at a
+    /// The rays of `active` that enter some child of the root node `root`, found for all of them at once, a child at a
     /// time (as many box tests as one ray's walk makes at the root): a ray that enters none would find nothing
     /// (e.g. most traced directions, in the lights' small tree), and need not walk.
     #[inline(always)]
-    fn entering_root(&self, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> u32 {
-        let node = &self.nodes[self.root.map_or(0, |r| r.first) as usize];
+    fn entering_root(&self, root: Child, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> u32 {
+        let node = &self.nodes[root.first as usize];
         let lanes = RayLanes::new(&Vec3x8::from_lanes(&rays.map(|r| r.0)), &Vec3x8::from_lanes(&rays.map(|r| r.1)));
         let (mut entering, mut children) = (0, node.used());
         while children != 0 && entering != active {
