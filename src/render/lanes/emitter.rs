@@ -5,7 +5,7 @@
 //! which the processor overlaps. Each lane computes what the scalar estimator computes, in the same order, bit for
 //! bit.
 
-use super::{LANES, mis_second_technique, mis_sums, shading_point};
+use super::{LANES, mis_second_technique, mis_sums};
 use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
@@ -151,6 +151,15 @@ impl EmitterLanes {
         }
     }
 
+    /// Lane `l`'s shading point (a lane that hit something), as `lanes::shading_point` sets it up, bit for bit:
+    /// p, n and ω_o went through the same operations in f32x8.
+    #[inline(always)]
+    fn shading_point<'a>(&self, scene: &'a Scene, l: usize) -> ShadingPoint<'a> {
+        let material = &scene.materials[self.materials[l] as usize];
+        let (p, n, wo, error) = (self.p.lane(l), self.n.lane(l), self.wo.lane(l), self.p_error.as_array_ref()[l]);
+        ShadingPoint { p, n, wo, material, error }
+    }
+
     /// The lanes of `active` whose shadow ray gets through; adds the rays traced to `rays`.
     #[inline(always)]
     fn visible(&self, scene: &Scene, active: u32, rays: &mut u64) -> u32 {
@@ -221,7 +230,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let mut shading: [Option<ShadingPoint>; LANES] = [None; LANES];
     let mut streams = [before.lane(0); LANES];
     for_each_lane(e.hit, |l| {
-        let Some((sp, _)) = shading_point(scene, dirs, hits, l) else { return };
+        let sp = e.shading_point(scene, l);
         // A sample that drew no point on a light (none picked, or p behind it) used one uniform, else three.
         let drew_point = e.picked & e.faces & (1 << l) != 0;
         streams[l] = if drew_point { rngs.lane(l) } else { before.lane(l).after_uniforms(1) };
