@@ -35,6 +35,14 @@ fn wait_for_reference(worker: &Worker) -> (Arc<Reference>, String) {
     }
 }
 
+/// Sends `commands`, then restarts the images, so that they render with all of them from their first sample: the
+/// worker starts rendering as it is spawned and, on a busy machine, may pass a target before the command setting it
+/// arrives (it then never shows a frame at the target).
+fn configure(worker: &Worker, commands: impl IntoIterator<Item = Command>) {
+    commands.into_iter().for_each(|c| worker.send(c));
+    worker.send(Command::Restart);
+}
+
 fn settings(strategy: Strategy) -> RenderSettings {
     RenderSettings { strategy, ..RenderSettings::default() }
 }
@@ -64,8 +72,7 @@ fn refines_then_restarts_on_a_new_strategy() {
 fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
     let scene = small_scene();
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
-    worker.send(Command::SetTargetSpp(Some(5)));
-    worker.send(Command::SetPassSize(PassSize::Fixed(2)));
+    configure(&worker, [Command::SetTargetSpp(Some(5)), Command::SetPassSize(PassSize::Fixed(2))]);
     let f = wait_for(&worker, |f| f.spp == 5);
     std::thread::sleep(Duration::from_millis(50));
     assert!(worker.take_frame().is_none(), "idle at the target");
@@ -82,7 +89,7 @@ fn stops_at_the_target_and_is_the_same_image_as_a_batch_render() {
 fn auto_passes_grow_from_one_sample_and_give_the_one_shot_image() {
     let scene = small_scene();
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
-    worker.send(Command::SetTargetSpp(Some(2000)));
+    configure(&worker, [Command::SetTargetSpp(Some(2000))]);
     let done = wait_for(&worker, |f| f.spp == 2000);
     assert!(done.passes < 200, "{} passes for 2000 spp: they grew", done.passes);
     let mut film = Film::new(32, 32);
@@ -101,8 +108,7 @@ fn kept_pixel_cones_give_the_one_shot_image_and_follow_the_camera() {
         film.means()
     };
     let worker = Worker::spawn(scene.clone(), RenderSettings::default(), 1, || {});
-    worker.send(Command::SetPassSize(PassSize::Fixed(4)));
-    worker.send(Command::SetTargetSpp(Some(12)));
+    configure(&worker, [Command::SetPassSize(PassSize::Fixed(4)), Command::SetTargetSpp(Some(12))]);
     let f = wait_for(&worker, |f| f.spp == 12);
     assert_eq!(f.passes, 3);
     assert_eq!(f.radiance, one_shot(&scene));
@@ -116,8 +122,7 @@ fn kept_pixel_cones_give_the_one_shot_image_and_follow_the_camera() {
 #[test]
 fn equal_samples_with_common_random_numbers_makes_identical_strategies_identical() {
     let worker = Worker::spawn(small_scene(), settings(Strategy::Brdf), 1, || {});
-    worker.send(Command::SetCompare(Some(settings(Strategy::Brdf))));
-    worker.send(Command::SetTargetSpp(Some(6)));
+    configure(&worker, [Command::SetCompare(Some(settings(Strategy::Brdf))), Command::SetTargetSpp(Some(6))]);
     let a = wait_for_lane(&worker, A, |f| f.spp == 6);
     let b = wait_for_lane(&worker, B, |f| f.spp == 6);
     assert_eq!(a.radiance, b.radiance, "A − B is zero everywhere");
