@@ -1,7 +1,7 @@
 //! The emitter triangles' own BVH. A direct-illumination estimator needs, along a traced direction ω, only
 //! L_i(ω) = L_e(x, −ω) at the first surface x met: zero unless x is on an emitter. So rather than the nearest of all
 //! triangles, it looks for the nearest *emitter* triangle on the ray, in this tree of the emitters alone, and then
-//! asks a shadow ray whether anything lies before it (`render::estimator::reached`). The answer is the same but
+//! asks a shadow ray whether anything lies before it (`render::estimator::lit`). The answer is the same but
 //! for ties within the rays' offsets; most traced directions miss every light (in a Cornell box, most of the
 //! hemisphere), and those are answered here without walking the scene's tree.
 
