@@ -357,11 +357,8 @@ impl Renderer {
                 let active = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32));
                 cone.closest_hits(&dirs, active, f32::INFINITY)
             }
-            None => HitLanes::from_hits(&std::array::from_fn(|l| {
-                (l < n)
-                    .then(|| self.scene.accel().closest_hit(self.camera.eye(), dirs.lane(l), f32::INFINITY))
-                    .flatten()
-            })),
+            // A pixel that sees too many triangles for a cone: its rays walk the tree as one packet.
+            None => self.scene.accel().closest_hits_from(self.camera.eye(), &dirs, (1 << n) - 1, f32::INFINITY),
         };
         *rays += n as u64;
         let strategy = self.settings.strategy;

@@ -319,6 +319,50 @@ mod tests {
         assert!(hit > 4000, "only {hit} rays hit: the test checks too little");
     }
 
+    /// Eight rays from one origin walking as a packet (`Accel::closest_hits_from`) find each the nearest distance
+    /// its lone walk finds, bit for bit, and the same triangle and barycentrics unless two triangles tie there
+    /// (coincident triangles): bundles as narrow as a pixel's camera rays and bundles in all directions, with some
+    /// lanes inactive, on soups of every size.
+    #[test]
+    fn eight_rays_from_one_origin_as_a_packet_find_what_each_finds_alone() {
+        let (mut hit, mut ties) = (0, 0);
+        let mut soups: Vec<Vec<[Vec3; 3]>> =
+            [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)].map(|(n, size)| random_soup(n, size, 90 + n as u64)).into();
+        soups.push(vec![[Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, -5.0, 0.0), Vec3::new(0.0, 5.0, 0.0)]; 300]);
+        for (k, tris) in soups.iter().enumerate() {
+            let (accel, _) = Accel::build(tris, &vec![None; tris.len()]);
+            for group in 0..1000u64 {
+                let mut rng = SampleRng::new(29, group, k as u64);
+                let mut point =
+                    |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
+                let (origin, target) = (point(16.0), point(4.0));
+                let spread = [0.01, 1.0, 16.0][group as usize % 3];
+                let dirs: [Vec3; 8] = std::array::from_fn(|_| target + point(spread) - origin);
+                let active = (group as u32).wrapping_mul(0x9e37_79b9) >> 24 | 1;
+                let t_max = [f32::INFINITY, 0.5][group as usize % 2];
+                let packet = accel.closest_hits_from(origin, &Vec3x8::from_lanes(&dirs), active, t_max);
+                for (l, &dir) in dirs.iter().enumerate() {
+                    let alone = (active & (1 << l) != 0).then(|| accel.closest_hit(origin, dir, t_max)).flatten();
+                    match (packet.lane(l), alone) {
+                        (None, None) => {}
+                        (Some(a), Some(b)) if a.triangle == b.triangle => {
+                            let key = |h: Hit| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits());
+                            assert_eq!(key(a), key(b), "soup {k}, group {group}, lane {l}");
+                        }
+                        (Some(a), Some(b)) => {
+                            assert_eq!(a.t.to_bits(), b.t.to_bits(), "soup {k}, group {group}, lane {l}: a tie");
+                            ties += 1;
+                        }
+                        (a, b) => panic!("soup {k}, group {group}, lane {l}: packet {a:?}, alone {b:?}"),
+                    }
+                    hit += alone.is_some() as u32;
+                }
+            }
+        }
+        assert!(hit > 4000, "only {hit} rays hit: the test checks too little");
+        eprintln!("{ties} ties kept otherwise than alone");
+    }
+
     #[test]
     fn agrees_on_coincident_and_needle_triangles() {
         // Thousands of identical triangles (a deep, degenerate tree: the depth limit makes one large leaf) and

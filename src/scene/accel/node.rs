@@ -86,6 +86,13 @@ impl Node8 {
     /// [`Node8::intersect`] for ray i, bit for bit (the same operations on the same values).
     #[inline(always)]
     pub fn intersect_lanes(&self, k: usize, rays: &RayLanes, t_max: f32) -> u32 {
+        self.enter_lanes(k, rays, f32x8::splat(t_max)).0
+    }
+
+    /// [`Node8::intersect_lanes`] with each ray's own `t_max` (lane i for ray i), and the distances at which the
+    /// rays enter the box: lane i is lane k of [`Node8::intersect`]'s for ray i.
+    #[inline(always)]
+    pub fn enter_lanes(&self, k: usize, rays: &RayLanes, t_max: f32x8) -> (u32, f32x8) {
         let slab = |a: usize, near: bool| {
             let (lo, hi) =
                 (f32x8::splat(self.bounds[a].as_array_ref()[k]), f32x8::splat(self.bounds[a + 3].as_array_ref()[k]));
@@ -94,8 +101,8 @@ impl Node8 {
         };
         let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
         let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
-        let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));
-        t_enter.cmp_le(t_exit).move_mask() as u32
+        let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(t_max);
+        (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
     }
 
     /// Bit i set when lane i holds a child.

@@ -19,6 +19,32 @@ pub(super) struct LaneHit {
     pub v: f32,
 }
 
+/// Eight rays' nearest hits so far, one per lane, as vectors: the distance (the ray's limit before any hit), the
+/// barycentrics and the triangle id (as f32 bits, for the blends; `u32::MAX` for none).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct NearestLanes {
+    pub t: f32x8,
+    u: f32x8,
+    v: f32x8,
+    id: f32x8,
+}
+
+impl NearestLanes {
+    /// No hit yet, below `t_max`.
+    #[inline(always)]
+    pub fn new(t_max: f32) -> Self {
+        Self { t: f32x8::splat(t_max), u: f32x8::ZERO, v: f32x8::ZERO, id: f32x8::splat(f32::from_bits(u32::MAX)) }
+    }
+
+    /// The hits found.
+    #[inline(always)]
+    pub fn hits(&self) -> HitLanes {
+        let triangle = self.id.to_array().map(f32::to_bits);
+        let mask = triangle.iter().enumerate().fold(0, |m, (l, &id)| m | ((id != u32::MAX) as u32) << l);
+        HitLanes { mask, triangle, t: self.t, u: self.u, v: self.v }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub(super) struct TrianglePacket {
     v0: [f32x8; 3],
@@ -65,7 +91,7 @@ impl TrianglePacket {
 
     #[inline(always)]
     fn test(&self, ray: &WideRay, t_max: f32) -> (u32, [f32x8; 4]) {
-        let (hit, tuvd) = moller_trumbore(&self.v0, &self.e1, &self.e2, &ray.o, &ray.d, t_max);
+        let (hit, tuvd) = moller_trumbore(&self.v0, &self.e1, &self.e2, &ray.o, &ray.d, f32x8::splat(t_max));
         (hit.move_mask() as u32, tuvd)
     }
 
@@ -95,7 +121,7 @@ impl TrianglePacket {
     /// The triangle in lane `k` against eight rays `o + t·d`, one per lane: [`moller_trumbore`] with the roles of
     /// the lanes swapped.
     #[inline(always)]
-    fn test_rays(&self, k: usize, o: &[f32x8; 3], d: &[f32x8; 3], t_max: f32) -> (f32x8, [f32x8; 4]) {
+    fn test_rays(&self, k: usize, o: &[f32x8; 3], d: &[f32x8; 3], t_max: f32x8) -> (f32x8, [f32x8; 4]) {
         let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
         moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), o, d, t_max)
     }
@@ -103,32 +129,35 @@ impl TrianglePacket {
     /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
     /// `active`, all bits set), with the packet's triangle ids: lane i gets the hit [`TrianglePacket::closest`] finds
     /// for ray i, bit for bit, as the same (triangle, ray) pairs go through the same arithmetic; only the roles of the
-    /// lanes are swapped. The best hits so far stay in vectors, updated by blends: no branch or store per lane.
+    /// lanes are swapped.
     #[inline(always)]
     pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> HitLanes {
-        let o = origin.to_array().map(f32x8::splat);
-        let d = [dirs.x, dirs.y, dirs.z];
-        let mut best_t = f32x8::splat(t_max);
-        let (mut best_u, mut best_v) = (f32x8::ZERO, f32x8::ZERO);
-        // The triangle ids ride in f32 lanes as bits, for the blends.
-        let mut best_id = f32x8::splat(f32::from_bits(u32::MAX));
+        let mut nearest = NearestLanes::new(t_max);
+        self.nearer_of_rays(&origin.to_array().map(f32x8::splat), &[dirs.x, dirs.y, dirs.z], active, &mut nearest);
+        nearest.hits()
+    }
+
+    /// Each of eight rays `o + t·d` (one per lane; those in `active`, all bits set) keeps in `nearest` the nearer
+    /// of its hit there and the packet's nearest hit at `0 < t <` that distance, as [`TrianglePacket::closest`]
+    /// finds it for the ray with that limit (the triangles are tested against the limit the ray came in with,
+    /// as there). The best hits stay in vectors, updated by blends: no branch or store per lane.
+    #[inline(always)]
+    pub fn nearer_of_rays(&self, o: &[f32x8; 3], d: &[f32x8; 3], active: f32x8, nearest: &mut NearestLanes) {
+        let limit = nearest.t;
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            let (hit, [t, u, v, det]) = self.test_rays(k, &o, &d, t_max);
+            let (hit, [t, u, v, det]) = self.test_rays(k, o, d, limit);
             let hit = hit & active;
             if hit.none() {
                 continue;
             }
             let inv = f32x8::ONE / det;
             let t = t * inv;
-            let nearer = hit & t.cmp_lt(best_t);
-            best_t = nearer.blend(t, best_t);
-            best_u = nearer.blend(u * inv, best_u);
-            best_v = nearer.blend(v * inv, best_v);
-            best_id = nearer.blend(f32x8::splat(f32::from_bits(self.ids[k])), best_id);
+            let nearer = hit & t.cmp_lt(nearest.t);
+            nearest.t = nearer.blend(t, nearest.t);
+            nearest.u = nearer.blend(u * inv, nearest.u);
+            nearest.v = nearer.blend(v * inv, nearest.v);
+            nearest.id = nearer.blend(f32x8::splat(f32::from_bits(self.ids[k])), nearest.id);
         }
-        let triangle = best_id.to_array().map(f32::to_bits);
-        let mask = triangle.iter().enumerate().fold(0, |m, (l, &id)| m | ((id != u32::MAX) as u32) << l);
-        HitLanes { mask, triangle, t: best_t, u: best_u, v: best_v }
     }
 
     /// The rays of `rays` (bit i for lane i) that hit one of the packet's triangles at `0 < t < t_max`: bit i is
@@ -137,7 +166,7 @@ impl TrianglePacket {
     pub fn any_of_rays(&self, rays: &RayLanes, t_max: f32) -> u32 {
         let mut hit = 0;
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            hit |= self.test_rays(k, &rays.o, &rays.d, t_max).0.move_mask() as u32;
+            hit |= self.test_rays(k, &rays.o, &rays.d, f32x8::splat(t_max)).0.move_mask() as u32;
         }
         hit
     }
@@ -149,8 +178,8 @@ impl TrianglePacket {
     }
 }
 
-/// Möller–Trumbore on eight (triangle, ray) pairs, one per lane. Returns the lanes hit at `0 < t < t_max` (all
-/// bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators with det's sign
+/// Möller–Trumbore on eight (triangle, ray) pairs, one per lane. Returns the lanes hit at `0 < t < t_max` (each
+/// lane's own limit; all bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators with det's sign
 /// folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
 #[inline(always)]
 fn moller_trumbore(
@@ -159,7 +188,7 @@ fn moller_trumbore(
     e2: &[f32x8; 3],
     o: &[f32x8; 3],
     d: &[f32x8; 3],
-    t_max: f32,
+    t_max: f32x8,
 ) -> (f32x8, [f32x8; 4]) {
     let [dx, dy, dz] = *d;
     let [e1x, e1y, e1z] = *e1;
@@ -175,7 +204,7 @@ fn moller_trumbore(
     let (su, sv, st) = (u.flip_signs(det), v.flip_signs(det), t.flip_signs(det));
     let zero = f32x8::ZERO;
     let inside = su.cmp_ge(zero) & sv.cmp_ge(zero) & (su + sv).cmp_le(abs_det);
-    let ahead = st.cmp_gt(zero) & st.cmp_lt(f32x8::splat(t_max) * abs_det);
+    let ahead = st.cmp_gt(zero) & st.cmp_lt(t_max * abs_det);
     (inside & ahead & abs_det.cmp_gt(zero), [t, u, v, det])
 }
 

@@ -6,12 +6,13 @@
 
 use super::build::MAX_DEPTH;
 use super::node::{Child, SKIP_NOTHING};
+use super::packet::NearestLanes;
 use super::ray::{RayLanes, WideRay};
-use super::{Accel, Hit};
+use super::{Accel, Hit, HitLanes};
 use crate::math::{Vec3x8, for_each_lane};
 use arrayvec::ArrayVec;
 use glam::Vec3;
-use wide::{CmpEq, i32x8};
+use wide::{CmpEq, CmpLt, f32x8, i32x8};
 
 /// Each level pushes at most seven children (the eighth is visited at once).
 pub(super) const STACK: usize = 7 * MAX_DEPTH + 8;
@@ -83,6 +84,68 @@ impl Accel {
             }
             std::array::from_fn(|l| if active & (1 << l) != 0 { walks[l].best } else { None })
         })
+    }
+
+    /// [`Accel::closest_hit`] for up to eight rays from one `origin` along `dirs` (those in `active`, bit l for
+    /// lane l), walking the tree as one packet (Wald et al., "Interactive Rendering with Coherent Ray Tracing",
+    /// 2001): rays that start together and point nearly alike, as a pixel's camera rays, enter nearly the same
+    /// subtrees, and each node and leaf is then loaded once for all of them. A child is entered by the rays whose
+    /// slab test admits it within their own nearest hit so far, nearest first (by the distance at which the first
+    /// of them enters it); a ray leaves the walk of a pending subtree it enters beyond its nearest hit. Each ray
+    /// meets every triangle its lone walk meets nearer than its nearest hit, through the same arithmetic, so each
+    /// finds the nearest distance its lone walk finds, bit for bit; where two triangles tie at it (a ray through
+    /// their common edge), the walks may keep different ones, as through a pixel's cone.
+    #[inline]
+    pub fn closest_hits_from(&self, origin: Vec3, dirs: &Vec3x8, active: u32, t_max: f32) -> HitLanes {
+        let mut nearest = NearestLanes::new(t_max);
+        let Some(root) = self.root.filter(|_| active != 0) else { return nearest.hits() };
+        let rays = RayLanes::new(&Vec3x8::splat(origin), dirs);
+        let mut stack = ArrayVec::<(Child, u32, f32x8), STACK>::new();
+        let (mut current, mut lanes) = (root, active);
+        loop {
+            if current.is_leaf() {
+                let entered = lane_mask(lanes);
+                for packet in &self.packets[current.first as usize..(current.first + current.packets) as usize] {
+                    packet.nearer_of_rays(&rays.o, &rays.d, entered, &mut nearest);
+                }
+            } else {
+                // The children entered, nearest on top (an insertion sort: at most eight).
+                let node = &self.nodes[current.first as usize];
+                let (mut order, mut n) = ([(0.0f32, Child::default(), 0u32, f32x8::ZERO); 8], 0);
+                let mut children = node.used();
+                while children != 0 {
+                    let k = children.trailing_zeros() as usize;
+                    children &= children - 1;
+                    let (entered, t_enter) = node.enter_lanes(k, &rays, nearest.t);
+                    let entered = entered & lanes;
+                    if entered == 0 {
+                        continue;
+                    }
+                    let key = t_enter.as_array_ref()[entered.trailing_zeros() as usize];
+                    let mut i = n;
+                    while i > 0 && order[i - 1].0 < key {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (key, node.children[k], entered, t_enter);
+                    n += 1;
+                }
+                if n > 0 {
+                    stack.extend(order[..n - 1].iter().map(|&(_, child, entered, t)| (child, entered, t)));
+                    (current, lanes) = (order[n - 1].1, order[n - 1].2);
+                    continue;
+                }
+            }
+            // Next: the nearest pending subtree, with the rays that may still find something nearer in it.
+            loop {
+                let Some((child, entered, t_enter)) = stack.pop() else { return nearest.hits() };
+                let entered = entered & t_enter.cmp_lt(nearest.t).move_mask() as u32;
+                if entered != 0 {
+                    (current, lanes) = (child, entered);
+                    break;
+                }
+            }
+        }
     }
 
     /// The rays of `active` that enter some child of the root node `root`, found for all of them at once, a child at a
@@ -382,6 +445,13 @@ thread_local! {
     static WALKS: std::cell::RefCell<Box<[ClosestHitWalk; 8]>> = std::cell::RefCell::new(Box::new(
         std::array::from_fn(|_| ClosestHitWalk::new(Child { first: 0, packets: 0 }, Vec3::ZERO, Vec3::Z, 0.0)),
     ));
+}
+
+/// All bits set in lane l of the result for each bit l of `lanes` (as a comparison sets them).
+#[inline(always)]
+fn lane_mask(lanes: u32) -> f32x8 {
+    let bits = i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
+    bytemuck::cast((i32x8::splat(lanes as i32) & bits).cmp_eq(bits))
 }
 
 /// A group to skip as the nodes store groups: its id, or [`SKIP_NOTHING`].
