@@ -1,8 +1,10 @@
 //! Ray queries for the integrator: the closest hit for camera rays (and, in the emitters' own tree, for traced
-//! directions: `scene::EmitterTree`), any hit with early exit for shadow rays. obvhs builds a binary BVH, which is collapsed into an 8-wide one whose nodes test eight child boxes
-//! and whose leaves test eight triangles against one ray at once (f32x8): one ray, wide nodes, as in Embree's
+//! directions: `scene::EmitterTree`), any hit with early exit for shadow rays. obvhs builds a binary BVH, which is
+//! collapsed into an 8-wide one whose nodes test eight child boxes and whose leaves test eight triangles against
+//! one ray at once (f32x8): one ray, wide nodes, as in Embree's
 //! BVH8 (Wald et al. 2014). A single ray needs no coherence with others, so every strategy's rays run as fast;
-//! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull.
+//! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull, and where a pixel
+//! sees too many triangles for one, its camera rays walk the tree as one packet.
 
 mod build;
 mod frustum;
