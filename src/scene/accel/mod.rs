@@ -175,6 +175,14 @@ mod tests {
 
     /// Closest hits and any hits against every triangle tested alone; any hits skipping group 0 against every
     /// triangle outside it (a clear hit on one of them is found; with no triangle hit at all, none is).
+    /// Random soups of 1 to 3 000 triangles (seeds from `seed`), then 300 coincident triangles.
+    fn soups_and_coincident_triangles(seed: u64) -> Vec<Vec<[Vec3; 3]>> {
+        let mut soups: Vec<Vec<[Vec3; 3]>> =
+            [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)].map(|(n, size)| random_soup(n, size, seed + n as u64)).into();
+        soups.push(vec![[Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, -5.0, 0.0), Vec3::new(0.0, 5.0, 0.0)]; 300]);
+        soups
+    }
+
     fn check_against_brute_force(tris: &[[Vec3; 3]], rays: u64) {
         let groups = groups_by_side(tris);
         let (accel, order) = Accel::build(tris, &groups);
@@ -291,10 +299,7 @@ mod tests {
     #[test]
     fn eight_closest_hit_walks_interleaved_answer_as_each_alone() {
         let mut hit = 0;
-        let mut soups: Vec<Vec<[Vec3; 3]>> =
-            [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)].map(|(n, size)| random_soup(n, size, 70 + n as u64)).into();
-        soups.push(vec![[Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, -5.0, 0.0), Vec3::new(0.0, 5.0, 0.0)]; 300]);
-        for (k, tris) in soups.iter().enumerate() {
+        for (k, tris) in soups_and_coincident_triangles(70).iter().enumerate() {
             let (accel, _) = Accel::build(tris, &vec![None; tris.len()]);
             for group in 0..1000u64 {
                 let mut rng = SampleRng::new(23, group, k as u64);
@@ -328,10 +333,7 @@ mod tests {
     #[test]
     fn eight_rays_from_one_origin_as_a_packet_find_what_each_finds_alone() {
         let (mut hit, mut ties) = (0, 0);
-        let mut soups: Vec<Vec<[Vec3; 3]>> =
-            [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8)].map(|(n, size)| random_soup(n, size, 90 + n as u64)).into();
-        soups.push(vec![[Vec3::new(-5.0, -5.0, 0.0), Vec3::new(5.0, -5.0, 0.0), Vec3::new(0.0, 5.0, 0.0)]; 300]);
-        for (k, tris) in soups.iter().enumerate() {
+        for (k, tris) in soups_and_coincident_triangles(90).iter().enumerate() {
             let (accel, _) = Accel::build(tris, &vec![None; tris.len()]);
             for group in 0..1000u64 {
                 let mut rng = SampleRng::new(29, group, k as u64);
