@@ -1,8 +1,8 @@
 //! Ray queries for the integrator: the closest hit for camera rays (and, in the emitters' own tree, for traced
 //! directions: `scene::EmitterTree`), any hit with early exit for shadow rays. obvhs builds a binary BVH, which is
 //! collapsed into an 8-wide one whose nodes test eight child boxes and whose leaves test eight triangles against
-//! one ray at once (f32x8): one ray, wide nodes, as in Embree's
-//! BVH8 (Wald et al. 2014). A single ray needs no coherence with others, so every strategy's rays run as fast;
+//! one ray at once (f32x8): one ray, wide nodes, as in Embree's BVH8 (Wald et al. 2014). A single ray needs no
+//! coherence with others, so every strategy's rays run as fast;
 //! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull, and where a pixel
 //! sees too many triangles for one, its camera rays walk the tree as one packet.
 
@@ -173,8 +173,6 @@ mod tests {
         tris.iter().map(group).collect()
     }
 
-    /// Closest hits and any hits against every triangle tested alone; any hits skipping group 0 against every
-    /// triangle outside it (a clear hit on one of them is found; with no triangle hit at all, none is).
     /// Random soups of 1 to 3 000 triangles (seeds from `seed`), then 300 coincident triangles.
     fn soups_and_coincident_triangles(seed: u64) -> Vec<Vec<[Vec3; 3]>> {
         let mut soups: Vec<Vec<[Vec3; 3]>> =
@@ -183,6 +181,8 @@ mod tests {
         soups
     }
 
+    /// Closest hits and any hits against every triangle tested alone; any hits skipping group 0 against every
+    /// triangle outside it (a clear hit on one of them is found; with no triangle hit at all, none is).
     fn check_against_brute_force(tris: &[[Vec3; 3]], rays: u64) {
         let groups = groups_by_side(tris);
         let (accel, order) = Accel::build(tris, &groups);

@@ -179,8 +179,8 @@ impl TrianglePacket {
 }
 
 /// Möller–Trumbore on eight (triangle, ray) pairs, one per lane. Returns the lanes hit at `0 < t < t_max` (each
-/// lane's own limit; all bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators with det's sign
-/// folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
+/// lane's own limit; all bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators
+/// with det's sign folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
 #[inline(always)]
 fn moller_trumbore(
     v0: &[f32x8; 3],
