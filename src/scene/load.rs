@@ -82,7 +82,7 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
         let spec = MeshSpec { obj: file_name.to_string_lossy().into_owned(), materials: BTreeMap::new() };
         let mut meshes = Meshes::default();
         meshes.load(&source, &spec, path)?;
-        let camera = auto_camera(&meshes.positions);
+        let camera = auto_camera(meshes.bounds());
         return meshes.into_scene(name, camera, path);
     }
     load_from(&source, &file_name, &name)
@@ -139,8 +139,11 @@ impl WorldCamera {
 /// Triangles and materials gathered from the meshes of one scene.
 #[derive(Default)]
 struct Meshes {
-    /// In the files' coordinates, f64: rebased and rounded to f32 once every mesh is in.
-    positions: Vec<[DVec3; 3]>,
+    /// The vertices of all meshes in the files' coordinates, f64: rebased and rounded to f32 once every mesh is
+    /// in. Each mesh's vertices are those its triangles use (tobj leaves out the others).
+    vertices: Vec<DVec3>,
+    /// Per triangle, its vertices' indices in `vertices`.
+    triangles: Vec<[u32; 3]>,
     material_ids: Vec<u32>,
     materials: Vec<Material>,
     names: Vec<String>,
@@ -248,16 +251,15 @@ impl Meshes {
                 Some(id) if id < materials.len() => base + id as u32,
                 _ => self.default_material(),
             };
-            let vertex = |i: u32| {
-                let i = 3 * i as usize;
-                DVec3::new(mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2])
-            };
-            self.positions.reserve(mesh.indices.len() / 3);
-            self.material_ids.reserve(mesh.indices.len() / 3);
-            for f in mesh.indices.chunks_exact(3) {
-                self.positions.push([vertex(f[0]), vertex(f[1]), vertex(f[2])]);
-                self.material_ids.push(material);
+            if self.vertices.len() + mesh.positions.len() / 3 > u32::MAX as usize {
+                return Err(SceneError::Mesh {
+                    path: obj_path, message: "more than 2³² vertices in the scene".into()
+                });
             }
+            let first = self.vertices.len() as u32;
+            self.vertices.extend(mesh.positions.chunks_exact(3).map(|p| DVec3::new(p[0], p[1], p[2])));
+            self.triangles.extend(mesh.indices.chunks_exact(3).map(|f| [first + f[0], first + f[1], first + f[2]]));
+            self.material_ids.resize(self.triangles.len(), material);
         }
         Ok(())
     }
@@ -270,19 +272,21 @@ impl Meshes {
         })
     }
 
+    /// The vertices' bounding box (infinite and inverted when there is none).
+    fn bounds(&self) -> (DVec3, DVec3) {
+        self.vertices.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)))
+    }
+
     /// Rebases a scene far from the origin (by more than 16 times its size) to its bounds' centre, in f64, then
     /// rounds to f32: it then renders as it would at the origin (f32 positions 10⁵ m out are 8 mm apart).
     fn into_scene(self, name: String, camera: WorldCamera, path: &Path) -> Result<Scene, SceneError> {
-        let (lo, hi) = self
-            .positions
-            .iter()
-            .flatten()
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+        let (lo, hi) = self.bounds();
         let (centre, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
         let origin = if centre.is_finite() && centre.length() > 16.0 * radius.max(1e-3) { centre } else { DVec3::ZERO };
-        let positions: Vec<[Vec3; 3]> = self.positions.iter().map(|t| t.map(|v| (v - origin).as_vec3())).collect();
-        // The f64 positions (72 bytes a triangle) are not needed while the tree is built.
-        drop(self.positions);
+        let vertex = |i: u32| (self.vertices[i as usize] - origin).as_vec3();
+        let positions: Vec<[Vec3; 3]> = self.triangles.iter().map(|t| t.map(vertex)).collect();
+        // Only the triangles' f32 positions are needed while the tree is built.
+        drop((self.vertices, self.triangles));
         let mut scene =
             Scene::new(name, camera.local(origin), &positions, &self.material_ids, self.materials, self.names)
                 .map_err(|e| match e {
@@ -309,9 +313,7 @@ fn from_mtl(m: &tobj::Material, o: Option<&MaterialOverride>) -> Material {
 }
 
 /// A camera for a bare OBJ: looks at the bounding box's centre along −z from far enough to see all of it.
-fn auto_camera(positions: &[[DVec3; 3]]) -> WorldCamera {
-    let (lo, hi) =
-        positions.iter().flatten().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+fn auto_camera((lo, hi): (DVec3, DVec3)) -> WorldCamera {
     let (centre, radius) = if lo.is_finite() && hi.is_finite() {
         (0.5 * (lo + hi), (0.5 * (hi - lo).length()).max(1e-3))
     } else {
@@ -329,18 +331,91 @@ fn auto_camera(positions: &[[DVec3; 3]]) -> WorldCamera {
     }
 }
 
-/// The names an OBJ's `usemtl` lines use that none of its materials has, each once.
+/// The names an OBJ's `usemtl` lines use that none of its materials has, each once. A `usemtl` line is one whose
+/// first word is `usemtl`, before any `#`; its name is the rest of the line up to a `#`, trimmed. The text is
+/// searched for the word rather than read line by line: a 1M-triangle OBJ has two million lines and a handful of
+/// `usemtl`s.
 fn unknown_materials(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
     let mut unknown: Vec<String> = Vec::new();
-    for line in obj.lines() {
-        let line = line.split('#').next().unwrap_or("").trim();
-        if let Some(name) = line.strip_prefix("usemtl").filter(|r| r.starts_with(char::is_whitespace)).map(str::trim)
-            && !name.is_empty()
-            && !materials.iter().any(|m| m.name == name)
-            && !unknown.iter().any(|u| u == name)
-        {
+    for (at, _) in obj.match_indices("usemtl") {
+        let line_start = obj[..at].rfind('\n').map_or(0, |i| i + 1);
+        let rest = &obj[at + "usemtl".len()..];
+        let rest = &rest[..rest.find('\n').unwrap_or(rest.len())];
+        let rest = rest.split('#').next().unwrap_or("");
+        if !obj[line_start..at].chars().all(char::is_whitespace) || !rest.starts_with(char::is_whitespace) {
+            continue;
+        }
+        let name = rest.trim();
+        if !name.is_empty() && !materials.iter().any(|m| m.name == name) && !unknown.iter().any(|u| u == name) {
             unknown.push(name.to_string());
         }
     }
     unknown
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `unknown_materials` as its doc says it, line by line.
+    fn unknown_line_by_line(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
+        let mut unknown: Vec<String> = Vec::new();
+        for line in obj.lines() {
+            let line = line.split('#').next().unwrap_or("").trim();
+            if let Some(name) =
+                line.strip_prefix("usemtl").filter(|r| r.starts_with(char::is_whitespace)).map(str::trim)
+                && !name.is_empty()
+                && !materials.iter().any(|m| m.name == name)
+                && !unknown.iter().any(|u| u == name)
+            {
+                unknown.push(name.to_string());
+            }
+        }
+        unknown
+    }
+
+    #[test]
+    fn the_unknown_materials_found_by_searching_are_those_of_every_line() {
+        let known = ["red", "white"].map(|name| tobj::Material { name: name.into(), ..Default::default() });
+        let lines = [
+            "usemtl red",
+            "usemtl blue",
+            "  usemtl\tgreen  ",
+            "usemtl green",
+            "# usemtl commented",
+            "xusemtl mixed",
+            "usemtlglued",
+            "usemtl",
+            "usemtl   ",
+            "usemtl # nothing",
+            "usemtl gold # shiny",
+            "usemtlusemtl twice",
+            "v 0 0 0",
+            "f 1 2 3",
+            "usemtl white\r",
+            "\u{a0}usemtl nbsp",
+            "usemtl two words",
+            "g usemtl not first",
+            "",
+            "usemtl blue",
+        ];
+        let mut checked = 0;
+        // Every line alone and at the start, the middle and the end of a file, with and without a final newline.
+        for (i, line) in lines.iter().enumerate() {
+            for obj in [
+                line.to_string(),
+                format!("{line}\n"),
+                format!("v 1 2 3\n{line}\nf 1 1 1"),
+                format!("{}\n{line}", lines[(i + 7) % lines.len()]),
+                lines.join("\n"),
+                lines[i..].join("\r\n"),
+            ] {
+                assert_eq!(unknown_materials(&obj, &known), unknown_line_by_line(&obj, &known), "{obj:?}");
+                checked += 1;
+            }
+        }
+        let all = lines.join("\n");
+        assert_eq!(unknown_materials(&all, &known), ["blue", "green", "gold", "nbsp", "two words"]);
+        assert_eq!(checked, 6 * lines.len());
+    }
 }

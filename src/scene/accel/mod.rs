@@ -152,7 +152,7 @@ mod tests {
         }
     }
 
-    fn random_soup(n: usize, size: f32, seed: u64) -> Vec<[Vec3; 3]> {
+    pub(super) fn random_soup(n: usize, size: f32, seed: u64) -> Vec<[Vec3; 3]> {
         let mut rng = SampleRng::new(seed, 0, 0);
         let mut point = |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
         (0..n)
