@@ -333,8 +333,8 @@ fn auto_camera((lo, hi): (DVec3, DVec3)) -> WorldCamera {
 
 /// The names an OBJ's `usemtl` lines use that none of its materials has, each once. A `usemtl` line is one whose
 /// first word is `usemtl`, before any `#`; its name is the rest of the line up to a `#`, trimmed. The text is
-/// searched for the word rather than read line by line: a 1M-triangle OBJ has two million lines and a handful of
-/// `usemtl`s.
+/// searched for the word rather than read line by line: a 1M-triangle OBJ has some 1.5 million lines and often a
+/// handful of `usemtl`s.
 fn unknown_materials(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
     let mut unknown: Vec<String> = Vec::new();
     for (at, _) in obj.match_indices("usemtl") {
