@@ -147,8 +147,8 @@ def main():
           f"Dr.Jit {dr.__version__}")
     print()
     print("| scene | strategy | illumlab whole process, s | Mitsuba warm render, s | illumlab faster by | "
-          "mean radiance illumlab / Mitsuba |")
-    print("|---|---|---:|---:|---:|---|")
+          "each round's ratio, range | mean radiance illumlab / Mitsuba |")
+    print("|---|---|---:|---:|---:|---:|---|")
     for scene_path in scenes:
         name = os.path.basename(scene_path).removesuffix(".toml")
         with tempfile.TemporaryDirectory() as work:
@@ -165,7 +165,10 @@ def main():
                     t, means["mitsuba"] = render_mitsuba(scene, spp, r + 1)
                     times["mitsuba"].append(t)
                 il, mt = (sorted(times[k])[rounds // 2] for k in ("illumlab", "mitsuba"))
+                # Each round's two runs follow each other, so their ratio shares the machine's speed of the moment.
+                ratios = [m / i for i, m in zip(times["illumlab"], times["mitsuba"])]
                 print(f"| {name} | {strategy} | {il:.3f} | {mt:.3f} | {mt / il:.2f}x | "
+                      f"{min(ratios):.2f}–{max(ratios):.2f}x | "
                       f"{means['illumlab']:.4f} / {means['mitsuba']:.4f} |", flush=True)
 
 
