@@ -1,5 +1,5 @@
 //! Building the 8-wide BVH: obvhs builds a binary BVH (PLOC clustering and reinsertion, Meister & Bittner 2018)
-//! whose small subtrees are chosen as leaves by the SAH ([`sah_leaves`]); the tree is collapsed top-down into
+//! whose small subtrees are chosen as leaves by the SAH ([`SahLeaves`]); the tree is collapsed top-down into
 //! nodes of up to eight children by repeatedly opening the child with the largest surface area (Wald et al.,
 //! "Getting Rid of Packets", 2008). Each leaf (at most eight triangles) becomes one packet: testing eight
 //! triangles at once costs what testing one does.
@@ -7,12 +7,12 @@
 use super::node::{Child, ChildGroups, NO_GROUP, Node8};
 use super::packet::TrianglePacket;
 use arrayvec::ArrayVec;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use obvhs::{
-    BvhBuildParams,
+    Boundable, BvhBuildParams,
+    aabb::Aabb,
     bvh2::{Bvh2, reinsertion::ReinsertionOptimizer},
     ploc::PlocBuilder,
-    triangle::Triangle as ObvhsTriangle,
 };
 
 /// Below this many node levels a subtree becomes one leaf, whatever its size; it bounds the traversal stack
@@ -33,7 +33,7 @@ pub(super) struct Built {
 
 /// Builds the tree over a non-empty triangle list, with each triangle's group (see [`super::Accel::build`]).
 pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
-    let (bvh, leaf_sizes) = binary_tree(positions);
+    let (bvh, sah) = binary_tree(positions);
     // Group ids are non-negative as i32; NO_GROUP and SKIP_NOTHING are negative.
     let groups = groups.iter().map(|g| g.map_or(NO_GROUP, |g| i32::try_from(g).expect("group id below 2³¹"))).collect();
     // Reserved ahead (a binary tree of n leaves collapses to about a seventh as many wide nodes; a packet holds
@@ -41,9 +41,7 @@ pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
     let wide = bvh.nodes.len() / 7 + 1;
     let mut builder = Builder {
         bvh: &bvh,
-        leaf_sizes,
-        gathered: Vec::new(),
-        stack: Vec::new(),
+        sah,
         positions,
         groups,
         nodes: Vec::with_capacity(wide),
@@ -56,57 +54,47 @@ pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
     Built { nodes, groups, packets, root, order }
 }
 
-/// obvhs's binary tree over the triangles, and per node its triangle count if it is a leaf (see [`sah_leaves`]).
-fn binary_tree(positions: &[[Vec3; 3]]) -> (Bvh2, Vec<u32>) {
-    let input = obvhs_triangles(positions);
+/// obvhs's binary tree over the triangles, and the leaves the SAH chooses in it.
+fn binary_tree(positions: &[[Vec3; 3]]) -> (Bvh2, SahLeaves) {
+    let input: &[Corners] = bytemuck::cast_slice(positions);
     // obvhs's fast preset: on a 1M-triangle mesh it builds in about two thirds of the medium preset's time, and its
     // trees cost no more to trace (callgrind, instructions per render: 1–2% fewer on the knot, as many on the
     // Cornell box). Its steps are those of `obvhs::bvh2::builder::build_bvh2_from_tris` but the last: the preset
     // neither pre-splits nor reinserts after the leaf collapse, and the collapse itself (which copies the whole
-    // tree: on a 1M-triangle mesh, about 200 of obvhs's 600 ms) is replaced by `sah_leaves`, which only marks the
+    // tree: on a 1M-triangle mesh, about 200 of obvhs's 600 ms) is replaced by `SahLeaves`, which only marks the
     // same leaves.
     let config = BvhBuildParams::fast_build();
     debug_assert!(!config.pre_split && config.post_collapse_reinsertion_batch_ratio_multiplier == 0.0);
     let mut bvh = PlocBuilder::with_capacity(input.len()).build(
         config.ploc_search_distance,
-        &input,
+        input,
         (0..input.len() as u32).collect(),
         config.sort_precision,
         config.search_depth_threshold,
     );
-    drop(input);
     ReinsertionOptimizer::default().run(&mut bvh, config.reinsertion_batch_ratio, None);
-    let leaf_sizes = sah_leaves(&bvh, config.max_prims_per_leaf, config.collapse_traversal_cost);
-    (bvh, leaf_sizes)
+    let sah = SahLeaves::new(&bvh, config.max_prims_per_leaf, config.collapse_traversal_cost);
+    (bvh, sah)
 }
 
-fn obvhs_triangles(positions: &[[Vec3; 3]]) -> Vec<ObvhsTriangle> {
-    positions.iter().map(|[a, b, c]| ObvhsTriangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect()
-}
+/// A triangle's corners as obvhs bounds them, read in place: copying a 1M-triangle mesh into obvhs's own
+/// triangle type (48 bytes each) took 48 MB of fresh memory. The box is the one obvhs's triangle gives (a min and
+/// max of the same values), so the tree is the same.
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(transparent)]
+struct Corners([Vec3; 3]);
 
-/// Appends the triangles under binary node `id` to `out`, in the order of a depth-first walk (left first);
-/// `stack` is scratch.
-fn subtree_triangles(bvh: &Bvh2, id: usize, out: &mut Vec<u32>, stack: &mut Vec<usize>) {
-    stack.clear();
-    stack.push(id);
-    while let Some(n) = stack.pop() {
-        let node = &bvh.nodes[n];
-        let first = node.first_index as usize;
-        if node.is_leaf() {
-            out.extend_from_slice(&bvh.primitive_indices[first..first + node.prim_count as usize]);
-        } else {
-            stack.extend([first + 1, first]);
-        }
+impl Boundable for Corners {
+    #[inline(always)]
+    fn aabb(&self) -> Aabb {
+        Aabb::from_points(&self.0.map(Vec3A::from))
     }
 }
 
 struct Builder<'a> {
     bvh: &'a Bvh2,
-    /// Per binary node, its triangle count if it is a leaf of the wide tree (see [`sah_leaves`]), else 0.
-    leaf_sizes: Vec<u32>,
-    /// Scratch of [`Builder::leaf`]: the triangles of a subtree, and the nodes still to visit.
-    gathered: Vec<u32>,
-    stack: Vec<usize>,
+    /// The leaves of the wide tree, and each node's triangles.
+    sah: SahLeaves,
     positions: &'a [[Vec3; 3]],
     /// Per input triangle, its group or [`NO_GROUP`].
     groups: Vec<i32>,
@@ -154,7 +142,7 @@ impl Builder<'_> {
     /// grow boxes: shadow rays leaving one wall would then enter the box it shares with the next, and on the
     /// Cornell box they tested 2.24 packets per ray instead of 1.43.
     fn splits(&self, id: usize) -> bool {
-        self.leaf_sizes[id] == 0
+        !self.sah.leaf[id]
     }
 
     fn half_area(&self, id: usize) -> f32 {
@@ -163,18 +151,7 @@ impl Builder<'_> {
 
     /// Every triangle under binary node `id`, eight to a packet, in the order of a depth-first walk (left first).
     fn leaf(&mut self, id: usize) -> (Child, i32) {
-        // A leaf of obvhs is read in place; a subtree (an SAH leaf, or one cut off at MAX_DEPTH) is gathered first.
-        let bvh = self.bvh;
-        let node = &bvh.nodes[id];
-        let mut gathered = std::mem::take(&mut self.gathered);
-        gathered.clear();
-        let triangles = if node.is_leaf() {
-            let first = node.first_index as usize;
-            &bvh.primitive_indices[first..first + node.prim_count as usize]
-        } else {
-            subtree_triangles(bvh, id, &mut gathered, &mut self.stack);
-            &gathered[..]
-        };
+        let triangles = self.sah.triangles(id);
         let first_packet = self.packets.len() as u32;
         for chunk in triangles.chunks(WIDTH) {
             let first_stored = self.order.len() as u32;
@@ -185,50 +162,75 @@ impl Builder<'_> {
             self.packets.push(packet);
         }
         let group = common_group(triangles.iter().map(|&t| self.groups[t as usize]));
-        self.gathered = gathered;
         (Child { first: first_packet, packets: self.packets.len() as u32 - first_packet }, group)
     }
 }
 
 /// The leaves of obvhs's SAH leaf collapse (`obvhs::bvh2::leaf_collapser::collapse`), marked without rewriting the
-/// tree: per binary node, its triangle count n if it is a leaf of the collapsed tree, else 0. Bottom up, an inner
-/// node whose two children are leaves becomes one when n = n_l + n_r ≤ `max_prims` and the SAH says testing its
-/// triangles costs no more than entering its children: A·(n − c_t) ≤ A_l·n_l + A_r·n_r (A: half surface areas,
-/// c_t: `traversal_cost`). Like obvhs, a tree of at most 2·`max_prims` + 1 nodes or `max_prims` triangles is kept
-/// as it is; the unit test checks that the leaves are obvhs's, triangle for triangle.
-fn sah_leaves(bvh: &Bvh2, max_prims: u32, traversal_cost: f32) -> Vec<u32> {
-    let nodes = &bvh.nodes;
-    let mut sizes: Vec<u32> = nodes.iter().map(|n| if n.is_leaf() { n.prim_count } else { 0 }).collect();
-    let max_prims = max_prims.clamp(1, 255);
-    if max_prims <= 1 || nodes.len() as u32 <= 2 * max_prims + 1 || bvh.primitive_indices.len() as u32 <= max_prims {
-        return sizes;
-    }
-    // Post-order, with an explicit stack (a degenerate tree may be as deep as it has triangles): a node is
-    // pushed again, marked, below its children, and decided when it comes up the second time.
-    let mut stack = vec![(0usize, false)];
-    while let Some((id, children_done)) = stack.pop() {
-        let node = &nodes[id];
-        if node.is_leaf() {
-            continue;
-        }
-        let first = node.first_index as usize;
-        if !children_done {
-            stack.extend([(id, true), (first + 1, false), (first, false)]);
-            continue;
-        }
-        let (left, right) = (&nodes[first], &nodes[first + 1]);
-        let (n_l, n_r) = (sizes[first], sizes[first + 1]);
-        let n = n_l + n_r;
-        if n_l > 0 && n_r > 0 && n <= max_prims {
-            let collapse_cost = node.aabb().half_area() * (n as f32 - traversal_cost);
-            let base_cost = left.aabb().half_area() * n_l as f32 + right.aabb().half_area() * n_r as f32;
-            let same_triangle = left.first_index == right.first_index && n == 2;
-            if collapse_cost <= base_cost || same_triangle {
-                sizes[id] = n;
+/// tree, and every node's triangles found without walking its subtree again.
+struct SahLeaves {
+    /// Per binary node, whether it is a leaf of the collapsed tree (at most `max_prims` triangles).
+    leaf: Vec<bool>,
+    /// Per binary node, where its subtree's triangles start and end in `triangles`.
+    spans: Vec<(u32, u32)>,
+    /// Every triangle, in the order of a depth-first walk (left first): each subtree's are consecutive.
+    triangles: Vec<u32>,
+}
+
+impl SahLeaves {
+    /// Bottom up, an inner node whose two children are leaves becomes one when n = n_l + n_r ≤ `max_prims` and the
+    /// SAH says testing its triangles costs no more than entering its children: A·(n − c_t) ≤ A_l·n_l + A_r·n_r
+    /// (A: half surface areas, c_t: `traversal_cost`). Like obvhs, a tree of at most 2·`max_prims` + 1 nodes or
+    /// `max_prims` triangles is kept as it is; the unit test checks that the leaves are obvhs's, triangle for
+    /// triangle.
+    ///
+    /// One walk, depth first and post-order, decides the leaves and lays out the triangles: the tree's nodes lie
+    /// scattered in memory after the reinsertion, so each walk of it costs a cache miss per node (on a
+    /// 1M-triangle mesh, about 100 ms), and the wide tree then reads a subtree's triangles in place.
+    fn new(bvh: &Bvh2, max_prims: u32, traversal_cost: f32) -> Self {
+        let nodes = &bvh.nodes;
+        let mut leaf: Vec<bool> = nodes.iter().map(|n| n.is_leaf()).collect();
+        let mut spans = vec![(0, 0); nodes.len()];
+        let mut triangles = Vec::with_capacity(bvh.primitive_indices.len());
+        let max_prims = max_prims.clamp(1, 255);
+        let collapse =
+            max_prims > 1 && nodes.len() as u32 > 2 * max_prims + 1 && bvh.primitive_indices.len() as u32 > max_prims;
+        // An explicit stack (a degenerate tree may be as deep as it has triangles): an inner node is pushed again,
+        // marked, below its children, and decided when it comes up the second time.
+        let mut stack = vec![(0usize, false)];
+        while let Some((id, children_done)) = stack.pop() {
+            let node = &nodes[id];
+            let at = node.first_index as usize;
+            let start = triangles.len() as u32;
+            if node.is_leaf() {
+                triangles.extend_from_slice(&bvh.primitive_indices[at..at + node.prim_count as usize]);
+                spans[id] = (start, triangles.len() as u32);
+                continue;
+            }
+            if !children_done {
+                stack.extend([(id, true), (at + 1, false), (at, false)]);
+                continue;
+            }
+            let ((first, middle), (_, end)) = (spans[at], spans[at + 1]);
+            spans[id] = (first, end);
+            let (n_l, n_r) = (middle - first, end - middle);
+            let n = n_l + n_r;
+            if collapse && leaf[at] && leaf[at + 1] && n <= max_prims {
+                let (left, right) = (&nodes[at], &nodes[at + 1]);
+                let collapse_cost = node.aabb().half_area() * (n as f32 - traversal_cost);
+                let base_cost = left.aabb().half_area() * n_l as f32 + right.aabb().half_area() * n_r as f32;
+                let same_triangle = left.first_index == right.first_index && n == 2;
+                leaf[id] = collapse_cost <= base_cost || same_triangle;
             }
         }
+        Self { leaf, spans, triangles }
     }
-    sizes
+
+    /// The triangles under binary node `id`, in the order of a depth-first walk (left first).
+    fn triangles(&self, id: usize) -> &[u32] {
+        let (first, end) = self.spans[id];
+        &self.triangles[first as usize..end as usize]
+    }
 }
 
 /// The group shared by all of `groups`, or [`NO_GROUP`].
@@ -245,20 +247,24 @@ mod tests {
     use super::*;
     use crate::scene::accel::tests::random_soup;
     use obvhs::bvh2::builder::build_bvh2_from_tris;
+    use obvhs::triangle::Triangle as ObvhsTriangle;
+
+    fn obvhs_triangles(positions: &[[Vec3; 3]]) -> Vec<ObvhsTriangle> {
+        positions.iter().map(|[a, b, c]| ObvhsTriangle { v0: (*a).into(), v1: (*b).into(), v2: (*c).into() }).collect()
+    }
 
     /// A tree, depth first (left first): per node its box and, for a leaf, its triangles in order.
     type Walk = Vec<([[u32; 3]; 2], Option<Vec<u32>>)>;
 
-    fn walk(bvh: &Bvh2, is_leaf: impl Fn(usize) -> bool) -> Walk {
+    /// `leaf_triangles(id)`: the triangles of node `id` if it is a leaf.
+    fn walk(bvh: &Bvh2, leaf_triangles: impl Fn(usize) -> Option<Vec<u32>>) -> Walk {
         let mut out = Walk::new();
         let mut stack = vec![0];
         while let Some(id) = stack.pop() {
             let node = &bvh.nodes[id];
             let bits = |v: glam::Vec3A| v.to_array().map(f32::to_bits);
             let first = node.first_index as usize;
-            if is_leaf(id) {
-                let mut triangles = Vec::new();
-                subtree_triangles(bvh, id, &mut triangles, &mut Vec::new());
+            if let Some(triangles) = leaf_triangles(id) {
                 out.push(([bits(node.aabb.min), bits(node.aabb.max)], Some(triangles)));
             } else {
                 out.push(([bits(node.aabb.min), bits(node.aabb.max)], None));
@@ -284,9 +290,24 @@ mod tests {
         for tris in &soups {
             let theirs =
                 build_bvh2_from_tris(&obvhs_triangles(tris), BvhBuildParams::fast_build(), &mut Default::default());
-            let (ours, sizes) = binary_tree(tris);
-            let expected = walk(&theirs, |id| theirs.nodes[id].is_leaf());
-            assert_eq!(walk(&ours, |id| sizes[id] > 0), expected, "{} triangles", tris.len());
+            let (ours, sah) = binary_tree(tris);
+            let expected = walk(&theirs, |id| {
+                let node = &theirs.nodes[id];
+                let first = node.first_index as usize;
+                node.is_leaf().then(|| theirs.primitive_indices[first..first + node.prim_count as usize].to_vec())
+            });
+            assert_eq!(
+                walk(&ours, |id| sah.leaf[id].then(|| sah.triangles(id).to_vec())),
+                expected,
+                "{} triangles",
+                tris.len()
+            );
+            // Every node's triangles (those a subtree cut off at MAX_DEPTH reads) are its children's, left first.
+            for (id, node) in ours.nodes.iter().enumerate().filter(|(_, n)| !n.is_leaf()) {
+                let first = node.first_index as usize;
+                assert_eq!(sah.triangles(id), [sah.triangles(first), sah.triangles(first + 1)].concat());
+            }
+            assert_eq!(sah.triangles(0).len(), tris.len());
             collapsed_anywhere += expected.iter().filter(|(_, t)| t.as_ref().is_some_and(|t| t.len() > 1)).count();
         }
         assert!(collapsed_anywhere > 1000, "the soups exercise the collapse: {collapsed_anywhere} leaves of 2–8");
