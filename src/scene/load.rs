@@ -7,6 +7,7 @@ use super::material::validate;
 use super::mtl::clean_mtl;
 use super::{Camera, Material, Scene, SceneError};
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -284,7 +285,7 @@ impl Meshes {
         let (centre, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
         let origin = if centre.is_finite() && centre.length() > 16.0 * radius.max(1e-3) { centre } else { DVec3::ZERO };
         let vertex = |i: u32| (self.vertices[i as usize] - origin).as_vec3();
-        let positions: Vec<[Vec3; 3]> = self.triangles.iter().map(|t| t.map(vertex)).collect();
+        let positions: Vec<[Vec3; 3]> = self.triangles.par_iter().map(|t| t.map(vertex)).collect();
         // Only the triangles' f32 positions are needed while the tree is built.
         drop((self.vertices, self.triangles));
         let mut scene =
