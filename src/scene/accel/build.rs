@@ -189,7 +189,7 @@ impl SahLeaves {
     /// 1M-triangle mesh, about 100 ms), and the wide tree then reads a subtree's triangles in place.
     fn new(bvh: &Bvh2, max_prims: u32, traversal_cost: f32) -> Self {
         let nodes = &bvh.nodes;
-        let mut leaf: Vec<bool> = nodes.iter().map(|n| n.is_leaf()).collect();
+        let mut leaf = vec![false; nodes.len()];
         let mut spans = vec![(0, 0); nodes.len()];
         let mut triangles = Vec::with_capacity(bvh.primitive_indices.len());
         let max_prims = max_prims.clamp(1, 255);
@@ -205,6 +205,7 @@ impl SahLeaves {
             if node.is_leaf() {
                 triangles.extend_from_slice(&bvh.primitive_indices[at..at + node.prim_count as usize]);
                 spans[id] = (start, triangles.len() as u32);
+                leaf[id] = true;
                 continue;
             }
             if !children_done {
