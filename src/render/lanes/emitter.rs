@@ -5,7 +5,7 @@
 //! which the processor overlaps. Each lane computes what the scalar estimator computes, in the same order, bit for
 //! bit.
 
-use super::{LANES, mis_second_technique, mis_sums};
+use super::{LANES, mis_brdf_technique, mis_sums};
 use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
@@ -203,8 +203,9 @@ pub fn estimate_emitter_lanes(
 /// MIS of emitter sampling and BRDF sampling, one direction each (the default `MisSettings`), for up to eight
 /// samples of one pixel: what [`super::estimate_mis_lanes`] gives each sample with these two techniques, bit for
 /// bit, with the light technique's directions drawn and weighed in f32x8 as [`estimate_emitter_lanes`] draws
-/// them. Each lane's BRDF direction is then drawn from its own stream where the light technique left it, and the
-/// BRDF directions walk the tree together, interleaved. Adds the rays traced to `rays`. Not inlined: in the
+/// them. Each lane's BRDF direction is then drawn from its own stream where the light technique left it, all
+/// eight in f32x8 ([`super::brdf`]), and the BRDF directions walk the tree together, interleaved. Adds the rays
+/// traced to `rays`. Not inlined: in the
 /// caller, beside emitter sampling's own path, it cost that path 9% more instructions (its random streams were no
 /// longer drawn in vectorised loops).
 #[inline(never)]
@@ -250,7 +251,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
         shading[l] = Some(sp);
     });
     // The BRDF directions, each drawn after its lane's light direction.
-    let from_brdf = mis_second_technique(&contexts, (&Emitter, &Brdf), &shading, &mut streams, rays);
+    let from_brdf = mis_brdf_technique(&contexts, &Emitter, &shading, &mut streams, rays);
     let visible = e.visible(scene, shadow_rays, rays);
     mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }

@@ -1,10 +1,12 @@
 //! Up to eight samples of one pixel at once, one per SIMD lane. The shadow rays of all lanes are offset together
 //! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk the emitters' own tree interleaved,
 //! and their shadow rays go together too. Emitter sampling,
-//! alone or as MIS's light technique, runs in f32x8 ([`emitter`]); the other techniques sample lane by lane.
+//! alone or as MIS's light technique, runs in f32x8 ([`emitter`]), and so does the default MIS's BRDF technique
+//! ([`brdf`]); the other techniques sample lane by lane.
 //! Every lane computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit
 //! for bit, so a film does not depend on how its samples were grouped.
 
+mod brdf;
 mod emitter;
 
 pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
@@ -209,6 +211,33 @@ fn mis_second_technique(
     weighted
 }
 
+/// [`mis_second_technique`] with BRDF sampling as the second technique, its directions, densities and f_r drawn in
+/// f32x8 ([`brdf::sample_brdf_lanes`]): each lane gets what the generic one gives it, bit for bit.
+#[inline(always)]
+fn mis_brdf_technique(
+    contexts: &[SampleContext; 2],
+    light: &impl Technique,
+    shading: &[Option<ShadingPoint>; LANES],
+    rngs: &mut [SampleRng; LANES],
+    rays: &mut u64,
+) -> [Vec3; LANES] {
+    let (scene, heuristic) = (contexts[1].scene, contexts[1].mis.heuristic);
+    let drawn = brdf::sample_brdf_lanes(shading, rngs);
+    let mut traced = TracedRays::default();
+    for_each_lane(drawn.contributing, |l| {
+        let Some(sp) = &shading[l] else { return };
+        let s = DirectionSample { wi: drawn.wi[l], pdf: drawn.pdf[l], target: Target::Trace };
+        traced.add_evaluated(l, sp, s, (drawn.f[l], drawn.cos[l]), rays);
+    });
+    let mut weighted = [Vec3::ZERO; LANES];
+    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
+        let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
+        let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
+        weighted[l] = value * (w / (1.0 * s.pdf));
+    }
+    weighted
+}
+
 /// Each lane's MIS estimate: the radiance its camera ray sees emitted, plus its first technique's weighted
 /// contribution unless that direction's shadow ray was blocked (bit l of `blocked`), plus its second's.
 #[inline(always)]
@@ -239,11 +268,24 @@ impl TracedRays {
     #[inline(always)]
     fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) -> Result<(), Outcome> {
         let (f, cos) = super::estimator::brdf_and_cos(sp, &s)?;
+        self.add_evaluated(l, sp, s, (f, cos), rays);
+        Ok(())
+    }
+
+    /// [`TracedRays::add`] for a direction whose f_r and ω·n are known (and not zero).
+    #[inline(always)]
+    fn add_evaluated(
+        &mut self,
+        l: usize,
+        sp: &ShadingPoint,
+        s: DirectionSample,
+        (f, cos): (Vec3, f32),
+        rays: &mut u64,
+    ) {
         *rays += 1;
         self.rays[l] = (crate::math::offset_ray_origin(sp.p, sp.n, sp.error), s.wi);
         self.pending[l] = Some(((sp.p, sp.n, sp.error), s, f, cos));
         self.lanes |= 1 << l;
-        Ok(())
     }
 
     /// Per lane: `f_r L_e (ω·n)` where the ray meets a surface that emits towards it, the emitter triangle and point

@@ -1,0 +1,222 @@
+//! Phong BRDF sampling ([`crate::render::strategy::Brdf`]) for up to eight shading points at once: the lobe
+//! choice, the cosine-weighted and the cos^α samples, the frames around n and ω_r, the mixture's density
+//! `p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α` and f_r run in f32x8. The transcendental functions (sin
+//! and cos of the sample's angle, the lobe's ln and expm1, the density's `cos^α`) are the scalar code's own calls,
+//! lane by lane, and every other operation is the scalar code's, in its order and without fused multiply-adds
+//! (as [`Vec3x8`]'s): each lane gets what `Brdf::sample` and `eval_brdf` give it, bit for bit.
+
+use super::LANES;
+use crate::math::{ONE_MINUS_EPSILON, SampleRng, Vec3x8, for_each_lane};
+use crate::render::ShadingPoint;
+use crate::sampling::phong_lobe_pdf_from_gap;
+use glam::Vec3;
+use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
+use wide::{CmpEq, CmpGt, CmpLt, f32x8};
+
+/// Per lane, a direction drawn from its material's BRDF mixture with what the estimator needs of it.
+#[derive(Default)]
+pub(super) struct BrdfSamples {
+    pub wi: [Vec3; LANES],
+    /// The mixture's density at ω_i (solid angle).
+    pub pdf: [f32; LANES],
+    /// `f_r(ω_i, ω_o)`.
+    pub f: [Vec3; LANES],
+    /// `ω_i·n`.
+    pub cos: [f32; LANES],
+    /// The lanes whose direction can carry light: drawn (a material that is not black), above the surface
+    /// (ω_i·n > 0), with p > 0 and f_r ≠ 0 (what `brdf_and_cos` lets through).
+    pub contributing: u32,
+}
+
+/// Draws each lane's direction as `Brdf::sample` does from `shading[l]` and the stream `rngs[l]` (two uniforms
+/// for every lane with a shading point), with its density, f_r and ω_i·n.
+#[inline]
+pub(super) fn sample_brdf_lanes(shading: &[Option<ShadingPoint>; LANES], rngs: &mut [SampleRng; LANES]) -> BrdfSamples {
+    let mut drawn = 0u32;
+    let (mut n, mut wo, mut kd, mut ks) =
+        ([Vec3::Z; LANES], [Vec3::Z; LANES], [Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let (mut alpha, mut p_d, mut u_x, mut u_y) = ([0.0; LANES], [1.0; LANES], [0.0; LANES], [0.0; LANES]);
+    for l in 0..LANES {
+        let Some(sp) = &shading[l] else { continue };
+        let u = rngs[l].uniform_2d();
+        let Some(p) = sp.material.diffuse_probability() else { continue };
+        drawn |= 1 << l;
+        (n[l], wo[l], kd[l], ks[l]) = (sp.n, sp.wo, sp.material.kd, sp.material.ks);
+        (alpha[l], p_d[l], u_x[l], u_y[l]) = (sp.material.alpha, p, u.x, u.y);
+    }
+    if drawn == 0 {
+        return BrdfSamples::default();
+    }
+    let (n, wo) = (Vec3x8::from_lanes(&n), Vec3x8::from_lanes(&wo));
+    let (p_d, u_x, u_y) = (f32x8::new(p_d), f32x8::new(u_x), f32x8::new(u_y));
+    let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+
+    // The lecture's Bernoulli lobe choice; u₀ rescaled and reused.
+    let diffuse = u_x.cmp_lt(p_d);
+    let diffuse_lanes = diffuse.move_mask() as u32 & drawn;
+    let u0_diffuse = (u_x / p_d).min(f32x8::splat(ONE_MINUS_EPSILON));
+    let u0_glossy = ((u_x - p_d) / (one - p_d)).max(zero).min(f32x8::splat(ONE_MINUS_EPSILON));
+    let u0 = diffuse.blend(u0_diffuse, u0_glossy);
+
+    // Diffuse: Shirley & Chiu's concentric disc, lifted to the hemisphere (`sample_cosine_hemisphere`).
+    let (o_x, o_y) = (f32x8::splat(2.0) * u0 - one, f32x8::splat(2.0) * u_y - one);
+    let x_wider = o_x.abs().cmp_gt(o_y.abs());
+    let radius = x_wider.blend(o_x, o_y);
+    let theta = x_wider
+        .blend(f32x8::splat(FRAC_PI_4) * (o_y / o_x), f32x8::splat(FRAC_PI_2) - f32x8::splat(FRAC_PI_4) * (o_x / o_y));
+    let centre = o_x.cmp_eq(zero) & o_y.cmp_eq(zero);
+    let theta = theta.as_array_ref();
+    let (mut cos_theta, mut sin_theta) = ([0.0; LANES], [0.0; LANES]);
+    for_each_lane(diffuse_lanes, |l| (cos_theta[l], sin_theta[l]) = (theta[l].cos(), theta[l].sin()));
+    let disc_x = centre.blend(zero, radius * f32x8::new(cos_theta));
+    let disc_y = centre.blend(zero, radius * f32x8::new(sin_theta));
+    let height = (one - (disc_x * disc_x + disc_y * disc_y)).max(zero).sqrt();
+    let cosine_sample = Vec3x8::new(disc_x, disc_y, height);
+
+    // Glossy: the cos^α lobe around ω_r (`sample_phong_lobe`): 1 − cos θ_r = −expm1(ln u₀ / (α+1)).
+    let u0_lanes = u0.as_array_ref();
+    let (mut gap, mut cos_phi, mut sin_phi) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
+    let phi = (f32x8::splat(2.0 * PI) * u_y).to_array();
+    for_each_lane(drawn & !diffuse_lanes, |l| {
+        gap[l] = (-(u0_lanes[l].ln() / (alpha[l] + 1.0)).exp_m1()).clamp(0.0, 1.0);
+        (cos_phi[l], sin_phi[l]) = (phi[l].cos(), phi[l].sin());
+    });
+    let gap = f32x8::new(gap);
+    let sin_theta_r = (gap * (f32x8::splat(2.0) - gap)).max(zero).sqrt();
+    let lobe_sample = Vec3x8::new(sin_theta_r * f32x8::new(cos_phi), sin_theta_r * f32x8::new(sin_phi), one - gap);
+
+    // Into the world: about n (diffuse) or ω_r = 2(n·ω_o)n − ω_o (glossy).
+    let wr = n * (f32x8::splat(2.0) * n.dot(wo)) - wo;
+    let axis = Vec3x8::select(diffuse, n, wr);
+    let wi = frame_to_world(axis, Vec3x8::select(diffuse, cosine_sample, lobe_sample));
+
+    // The lobe's value at ω_i, from `|ω_i − ω_r|²/2`: for the density where Pr_d < 1, for f_r where k_s ≠ 0.
+    let cos = n.dot(wi);
+    let cos_o = n.dot(wo);
+    let diff = wi - wr;
+    let mirror_gap = (f32x8::splat(0.5) * diff.dot(diff)).to_array();
+    let (p_d_lanes, cos_lanes) = (p_d.as_array_ref(), cos.as_array_ref());
+    let mut lobe = [0.0; LANES];
+    let above = (cos.cmp_gt(zero) & cos_o.cmp_gt(zero)).move_mask() as u32;
+    for_each_lane(drawn, |l| {
+        let for_density = p_d_lanes[l] < 1.0;
+        let for_brdf = ks[l] != Vec3::ZERO && above & (1 << l) != 0;
+        if for_density || for_brdf {
+            lobe[l] = phong_lobe_pdf_from_gap(mirror_gap[l], alpha[l]);
+        }
+    });
+    let lobe = f32x8::new(lobe);
+    let pdf = p_d * (cos.max(zero) * f32x8::splat(FRAC_1_PI));
+    let pdf = p_d.cmp_lt(one).blend(pdf + (one - p_d) * lobe, pdf);
+
+    // f_r = k_d/π + k_s lobe, 0 with either direction below the surface; `brdf_and_cos`'s checks.
+    let (pdf, cos_out) = (pdf.to_array(), *cos_lanes);
+    let mut f = [Vec3::ZERO; LANES];
+    let mut contributing = 0;
+    for_each_lane(drawn, |l| {
+        if !(cos_out[l] > 0.0 && pdf[l] > 0.0) {
+            return;
+        }
+        if above & (1 << l) != 0 {
+            f[l] = kd[l] * FRAC_1_PI;
+            if ks[l] != Vec3::ZERO {
+                f[l] += ks[l] * lobe.as_array_ref()[l];
+            }
+        }
+        if f[l] != Vec3::ZERO {
+            contributing |= 1 << l;
+        }
+    });
+    let wi = std::array::from_fn(|l| wi.lane(l));
+    BrdfSamples { wi, pdf, f, cos: cos_out, contributing }
+}
+
+/// `Frame::from_z(z).to_world(v)` lane by lane (Duff et al. 2017), in the scalar code's order.
+#[inline(always)]
+fn frame_to_world(z: Vec3x8, v: Vec3x8) -> Vec3x8 {
+    let flip = f32x8::splat(-0.0);
+    let sign = f32x8::ONE.copysign(z.z);
+    let a = (f32x8::ONE ^ flip) / (sign + z.z);
+    let b = z.x * z.y * a;
+    let s = Vec3x8::new(f32x8::ONE + sign * z.x * z.x * a, sign * b, (sign ^ flip) * z.x);
+    let t = Vec3x8::new(b, sign + z.y * z.y * a, z.y ^ flip);
+    s * v.x + t * v.y + z * v.z
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::MisSettings;
+    use crate::render::strategy::{Brdf, DirectionStrategy, SampleContext};
+    use crate::scene::{Material, load_scene};
+
+    /// Every lane's direction, density, f_r and ω_i·n are `Brdf::sample`'s and `eval_brdf`'s, bit for bit, and so
+    /// is which lanes contribute: materials diffuse, glossy (α from 0 to 10⁶), with k_s too small to move the
+    /// lobe choice off 1, and black; random normals and viewing directions, some lanes without a shading point.
+    #[test]
+    fn eight_lanes_draw_what_brdf_sampling_draws_lane_by_lane() {
+        let materials = [
+            Material::default(),
+            Material { kd: Vec3::new(0.3, 0.2, 0.1), ks: Vec3::splat(0.6), alpha: 40.0, ..Default::default() },
+            Material { kd: Vec3::ZERO, ks: Vec3::ONE, alpha: 1e6, ..Default::default() },
+            Material { kd: Vec3::splat(0.2), ks: Vec3::splat(0.5), alpha: 0.0, ..Default::default() },
+            // Pr_d = 3/(3 + 10⁻⁷) rounds to 1, yet k_s·lobe shows in f_r near ω_r.
+            Material { kd: Vec3::ONE, ks: Vec3::new(1e-7, 0.0, 0.0), alpha: 100.0, ..Default::default() },
+            Material { kd: Vec3::ZERO, ks: Vec3::ZERO, ..Default::default() },
+            Material { kd: Vec3::splat(0.1), ks: Vec3::splat(0.8), alpha: 3000.0, ..Default::default() },
+        ];
+        let scene = load_scene("cornell-box").expect("bundled scene");
+        let mis = MisSettings::default();
+        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: None, guide: None };
+        let mut setup = SampleRng::new(11, 0, 0);
+        let mut unit = || {
+            let w = crate::sampling::sample_uniform_hemisphere(setup.uniform_2d());
+            if setup.uniform() < 0.5 { w } else { -w }
+        };
+        assert_eq!(materials[4].diffuse_probability(), Some(1.0));
+        let (mut contributing, mut glossy, mut unseen_lobe) = (0, 0, 0);
+        for group in 0..4000u64 {
+            let shading: [Option<ShadingPoint>; LANES] = std::array::from_fn(|l| {
+                let n = unit();
+                let wo = unit();
+                let wo = if n.dot(wo) < 0.0 { -wo } else { wo };
+                let material = &materials[(group as usize * 3 + l) % materials.len()];
+                (!(l as u64 + group).is_multiple_of(9)).then_some(ShadingPoint {
+                    p: Vec3::ZERO,
+                    n,
+                    wo,
+                    material,
+                    error: 0.0,
+                })
+            });
+            let mut lanes: [SampleRng; LANES] = std::array::from_fn(|l| SampleRng::new(5, group, l as u64));
+            let mut alone = lanes;
+            let drawn = sample_brdf_lanes(&shading, &mut lanes);
+            for l in 0..LANES {
+                let Some(sp) = &shading[l] else { continue };
+                let s = Brdf.sample(&ctx, sp, &mut alone[l]);
+                assert_eq!(lanes[l].uniform().to_bits(), alone[l].uniform().to_bits(), "streams left alike");
+                let Some(s) = s else {
+                    assert_eq!(drawn.contributing & (1 << l), 0);
+                    continue;
+                };
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(bits(drawn.wi[l]), bits(s.wi), "group {group} lane {l}: {:?}", sp.material);
+                assert_eq!(drawn.pdf[l].to_bits(), s.pdf.to_bits(), "group {group} lane {l}");
+                let cos = sp.n.dot(s.wi);
+                let f = sp.material.eval_brdf(sp.n, sp.wo, s.wi);
+                let contributes = cos > 0.0 && s.pdf > 0.0 && f != Vec3::ZERO;
+                assert_eq!(drawn.contributing & (1 << l) != 0, contributes, "group {group} lane {l}");
+                if contributes {
+                    assert_eq!(bits(drawn.f[l]), bits(f));
+                    assert_eq!(drawn.cos[l].to_bits(), cos.to_bits());
+                    contributing += 1;
+                    glossy += (sp.material.ks != Vec3::ZERO) as u32;
+                    unseen_lobe += (sp.material == &materials[4] && f != sp.material.kd * FRAC_1_PI) as u32;
+                }
+            }
+        }
+        assert!(contributing > 10_000 && glossy > 5_000, "{contributing} contributing, {glossy} glossy");
+        assert!(unseen_lobe > 20, "{unseen_lobe} directions where a lobe the lobe choice never draws shows in f_r");
+    }
+}
