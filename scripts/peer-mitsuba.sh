@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 venv=${MITSUBA_VENV:-/opt/mitsuba-venv}
-if [ ! -x "$venv/bin/python" ] || ! "$venv/bin/python" -c 'import mitsuba' 2>/dev/null; then
+if [ ! -x "$venv/bin/python" ] || ! "$venv/bin/python" -c 'import mitsuba, numpy' 2>/dev/null; then
   python3 -m venv "$venv"
   "$venv/bin/pip" install --quiet mitsuba numpy
 fi
