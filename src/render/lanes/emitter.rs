@@ -205,9 +205,8 @@ pub fn estimate_emitter_lanes(
 /// bit, with the light technique's directions drawn and weighed in f32x8 as [`estimate_emitter_lanes`] draws
 /// them. Each lane's BRDF direction is then drawn from its own stream where the light technique left it, all
 /// eight in f32x8 ([`super::brdf`]), and the BRDF directions walk the tree together, interleaved. Adds the rays
-/// traced to `rays`. Not inlined: in the
-/// caller, beside emitter sampling's own path, it cost that path 9% more instructions (its random streams were no
-/// longer drawn in vectorised loops).
+/// traced to `rays`. Not inlined: in the caller, beside emitter sampling's own path, it cost that path 9% more
+/// instructions (its random streams were no longer drawn in vectorised loops).
 #[inline(never)]
 pub fn estimate_mis_emitter_brdf_lanes(
     ctx: &SampleContext,

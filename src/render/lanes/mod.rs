@@ -13,7 +13,7 @@ pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
 
 use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
-use super::strategy::{DirectionSample, SampleContext, Technique};
+use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
 use crate::math::{SampleRng, SurfaceError, Vec3x8, for_each_lane};
 use crate::scene::{HitLanes, SKIP_NONE, Scene};
@@ -141,7 +141,6 @@ pub fn estimate_mis_lanes(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    use super::strategy::Reached;
     use super::strategy::mis::technique_context;
     let scene = ctx.scene;
     let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
@@ -190,7 +189,7 @@ fn mis_second_technique(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    let (scene, heuristic) = (contexts[1].scene, contexts[1].mis.heuristic);
+    let scene = contexts[1].scene;
     let mut weighted = [Vec3::ZERO; LANES];
     let mut traced = TracedRays::default();
     for l in 0..LANES {
@@ -199,14 +198,12 @@ fn mis_second_technique(
         if let Target::Trace = s.target {
             let _ = traced.add(l, sp, s, rays);
         } else if let Ok((value, via)) = integrand(scene, sp, &s, rays) {
-            let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
-            weighted[l] = value * (w / (1.0 * s.pdf));
+            weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
         }
     }
     for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
         let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
-        let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
-        weighted[l] = value * (w / (1.0 * s.pdf));
+        weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
     }
     weighted
 }
@@ -221,7 +218,7 @@ fn mis_brdf_technique(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    let (scene, heuristic) = (contexts[1].scene, contexts[1].mis.heuristic);
+    let scene = contexts[1].scene;
     let drawn = brdf::sample_brdf_lanes(shading, rngs);
     let mut traced = TracedRays::default();
     for_each_lane(drawn.contributing, |l| {
@@ -232,10 +229,24 @@ fn mis_brdf_technique(
     let mut weighted = [Vec3::ZERO; LANES];
     for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
         let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
-        let w = heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
-        weighted[l] = value * (w / (1.0 * s.pdf));
+        weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
     }
     weighted
+}
+
+/// A second-technique sample's share, one direction per technique: `w₂ f_r L_e (ω·n) / p₂` with `value` =
+/// `f_r L_e (ω·n)` and `w₂` the heuristic's weight against `light`'s density at ω (reached `via` its emitter).
+#[inline(always)]
+fn weighted_second(
+    contexts: &[SampleContext; 2],
+    light: &impl Technique,
+    sp: &ShadingPoint,
+    value: Vec3,
+    via: Reached,
+    s: &DirectionSample,
+) -> Vec3 {
+    let w = contexts[1].mis.heuristic.weight(1, s.pdf, 1, light.pdf(&contexts[0], sp, s.wi, Some(via)));
+    value * (w / (1.0 * s.pdf))
 }
 
 /// Each lane's MIS estimate: the radiance its camera ray sees emitted, plus its first technique's weighted
