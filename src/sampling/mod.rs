@@ -9,6 +9,7 @@ mod phong_lobe;
 mod phong_ltc_table;
 mod projected_triangle;
 mod spherical_triangle;
+mod spherical_triangle_lanes;
 mod triangle;
 
 pub use discrete::DiscreteDistribution;
@@ -25,4 +26,5 @@ pub use spherical_triangle::{
     MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA, sample_spherical_triangle, spherical_triangle_area,
     spherical_triangle_pdf,
 };
+pub use spherical_triangle_lanes::sample_spherical_triangle_lanes;
 pub use triangle::{sample_uniform_triangle, uniform_triangle_pdf_area};

@@ -2,14 +2,17 @@
 //! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk the emitters' own tree interleaved,
 //! and their shadow rays go together too. Emitter sampling,
 //! alone or as MIS's light technique, runs in f32x8 ([`emitter`]), and so does the default MIS's BRDF technique
-//! ([`brdf`]); the other techniques sample lane by lane.
+//! ([`brdf`]); `solid-angle` draws its spherical triangles together in f64x4 ([`solid_angle`]); the other
+//! techniques sample lane by lane.
 //! Every lane computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit
 //! for bit, so a film does not depend on how its samples were grouped.
 
 mod brdf;
 mod emitter;
+mod solid_angle;
 
 pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
+pub use solid_angle::estimate_solid_angle_lanes;
 
 use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
@@ -38,34 +41,57 @@ pub fn estimate_one_sample_lanes(
     rngs: &mut [SampleRng; LANES],
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    let scene = ctx.scene;
-    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let (mut shadow_rays, mut traced) = (ShadowRays::default(), TracedRays::default());
-    for l in 0..LANES {
-        let Some((sp, le)) = shading_point(scene, dirs, hits, l) else { continue };
-        emitted[l] = le;
-        let Some(s) = strategy.sample(ctx, &sp, &mut rngs[l]) else { continue };
+    let mut lanes = OneSampleLanes::default();
+    for (l, rng) in rngs.iter_mut().enumerate() {
+        let Some((sp, le)) = shading_point(ctx.scene, dirs, hits, l) else { continue };
+        lanes.emitted[l] = le;
+        if let Some(s) = strategy.sample(ctx, &sp, rng) {
+            lanes.add(l, ctx.scene, &sp, s, rays);
+        }
+    }
+    lanes.finish(ctx.scene, rays)
+}
+
+/// The one-sample estimator's lanes as their directions are added: the radiance each camera ray sees emitted,
+/// each direction's unshadowed `f_r L_e (ω·n) / p` with its shadow ray, or its traced ray.
+#[derive(Default)]
+pub(super) struct OneSampleLanes {
+    pub emitted: [Vec3; LANES],
+    reflected: [Vec3; LANES],
+    shadow_rays: ShadowRays,
+    traced: TracedRays,
+}
+
+impl OneSampleLanes {
+    /// Lane `l`'s direction `s` from `sp`.
+    #[inline(always)]
+    pub fn add(&mut self, l: usize, scene: &Scene, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) {
         match s.target {
             Target::Emitter { triangle, point } => {
-                let Ok((value, n_x)) = unshadowed(scene, &sp, &s, triangle) else { continue };
-                reflected[l] = value / s.pdf;
-                shadow_rays.add(l, scene, &sp, (triangle, point, n_x));
+                let Ok((value, n_x)) = unshadowed(scene, sp, &s, triangle) else { return };
+                self.reflected[l] = value / s.pdf;
+                self.shadow_rays.add(l, scene, sp, (triangle, point, n_x));
             }
             Target::Trace => {
-                let _ = traced.add(l, &sp, s, rays);
+                let _ = self.traced.add(l, sp, s, rays);
             }
         }
     }
-    let visible = shadow_rays.trace(scene, rays);
-    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
-        if let Ok((value, _, s)) = found {
-            reflected[l] = value / s.pdf;
+
+    /// Traces the rays together; each lane's estimate.
+    #[inline(always)]
+    pub fn finish(mut self, scene: &Scene, rays: &mut u64) -> [Vec3; LANES] {
+        let visible = self.shadow_rays.trace(scene, rays);
+        for (l, found) in self.traced.trace(scene, rays).into_iter().enumerate() {
+            if let Ok((value, _, s)) = found {
+                self.reflected[l] = value / s.pdf;
+            }
         }
+        std::array::from_fn(|l| {
+            let shadowed = self.shadow_rays.lanes & !visible & (1 << l) != 0;
+            self.emitted[l] + if shadowed { Vec3::ZERO } else { self.reflected[l] }
+        })
     }
-    std::array::from_fn(|l| {
-        let shadowed = shadow_rays.lanes & !visible & (1 << l) != 0;
-        emitted[l] + if shadowed { Vec3::ZERO } else { reflected[l] }
-    })
 }
 
 /// Lane `l`'s shading point (where its camera ray along `dirs` hit, if it did) and the radiance it emits

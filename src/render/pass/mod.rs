@@ -4,7 +4,7 @@
 
 use super::lanes::{
     LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_emitter_brdf_lanes, estimate_mis_lanes,
-    estimate_one_sample_lanes,
+    estimate_one_sample_lanes, estimate_solid_angle_lanes,
 };
 use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
@@ -371,7 +371,7 @@ impl Renderer {
                 let ctx = self.context();
                 // The bundled light strategies' own code, inlined; any other through the registry.
                 match strategy {
-                    Strategy::SolidAngle => estimate_one_sample_lanes(&ctx, &SolidAngle, &dirs, &hits, &mut rngs, rays),
+                    Strategy::SolidAngle => estimate_solid_angle_lanes(&ctx, &dirs, &hits, &mut rngs, rays),
                     Strategy::ProjectedSolidAngle => {
                         estimate_one_sample_lanes(&ctx, &ProjectedSolidAngle, &dirs, &hits, &mut rngs, rays)
                     }

@@ -49,13 +49,29 @@ pub fn sample_light<T: TriangleSampler>(
     sp: &ShadingPoint,
     rng: &mut SampleRng,
 ) -> Option<DirectionSample> {
+    let (triangle, p_delta, tri) = pick_facing(ctx, sp, rng)?;
+    light_sample(triangle, p_delta, T::sample_triangle(sp, tri, rng))
+}
+
+/// [`sample_light`]'s first step: Δ picked with p_Δ from the stream's next uniform, if `sp` sees its emitting side
+/// (the back of a one-sided emitter: L_i = 0, no sample).
+#[inline(always)]
+pub fn pick_facing<'a>(
+    ctx: &SampleContext<'a>,
+    sp: &ShadingPoint,
+    rng: &mut SampleRng,
+) -> Option<(u32, f32, &'a Triangle)> {
     let emitters = ctx.emitters?;
     let (triangle, p_delta) = emitters.pick(ctx.scene, sp.p, rng.uniform())?;
     let tri = &ctx.scene.triangles[triangle as usize];
-    if !faces(tri, sp.p) {
-        return None; // the back of a one-sided emitter: L_i = 0
-    }
-    let (wi, pdf, point) = T::sample_triangle(sp, tri, rng)?;
+    faces(tri, sp.p).then_some((triangle, p_delta, tri))
+}
+
+/// [`sample_light`]'s last step: the direction drawn towards Δ (with its density given Δ and the point it aims
+/// at) as a sample of density `p_Δ p(ω | Δ)`, if that is positive and finite.
+#[inline(always)]
+pub fn light_sample(triangle: u32, p_delta: f32, drawn: Option<(Vec3, f32, Vec3)>) -> Option<DirectionSample> {
+    let (wi, pdf, point) = drawn?;
     let pdf = p_delta * pdf;
     (pdf > 0.0 && pdf.is_finite()).then_some(DirectionSample { wi, pdf, target: Target::Emitter { triangle, point } })
 }

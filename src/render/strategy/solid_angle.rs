@@ -16,28 +16,40 @@ use glam::Vec3;
 
 pub struct SolidAngle;
 
-fn spherical(solid_angle: f32) -> bool {
-    (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&solid_angle)
+impl SolidAngle {
+    /// Ω_Δ seen from p, and whether Arvo's construction samples it there (else the area is sampled).
+    #[inline(always)]
+    pub fn solid_angle_at(p: Vec3, tri: &Triangle) -> (f32, bool) {
+        let [a, b, c] = tri.v;
+        let omega = spherical_triangle_area(p, a, b, c);
+        (omega, (MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&omega))
+    }
+
+    /// What `sample_triangle` gives for the direction `wi` drawn by Arvo's construction (`None`: none was), with
+    /// Ω_Δ = `omega` in the spherical range: ω, `1/Ω_Δ` and the point ω aims at on Δ.
+    #[inline(always)]
+    pub fn spherical_sample(p: Vec3, tri: &Triangle, omega: f32, wi: Option<Vec3>) -> Option<(Vec3, f32, Vec3)> {
+        let wi = wi?;
+        let x = hit_plane(p, wi, tri)?;
+        Some((wi, spherical_triangle_pdf(omega), x))
+    }
 }
 
 impl TriangleSampler for SolidAngle {
     #[inline]
     fn sample_triangle(sp: &ShadingPoint, tri: &Triangle, rng: &mut SampleRng) -> Option<(Vec3, f32, Vec3)> {
-        let [a, b, c] = tri.v;
-        let omega = spherical_triangle_area(sp.p, a, b, c);
-        if !spherical(omega) {
+        let (omega, spherical) = Self::solid_angle_at(sp.p, tri);
+        if !spherical {
             return Emitter::sample_triangle(sp, tri, rng);
         }
-        let wi = sample_spherical_triangle(rng.uniform_2d(), sp.p, a, b, c)?;
-        let x = hit_plane(sp.p, wi, tri)?;
-        Some((wi, spherical_triangle_pdf(omega), x))
+        let [a, b, c] = tri.v;
+        Self::spherical_sample(sp.p, tri, omega, sample_spherical_triangle(rng.uniform_2d(), sp.p, a, b, c))
     }
 
     #[inline]
     fn triangle_pdf(sp: &ShadingPoint, tri: &Triangle, x: Vec3, wi: Vec3) -> f32 {
-        let [a, b, c] = tri.v;
-        let omega = spherical_triangle_area(sp.p, a, b, c);
-        if spherical(omega) { spherical_triangle_pdf(omega) } else { area_pdf_solid_angle(sp.p, tri, x, wi) }
+        let (omega, spherical) = Self::solid_angle_at(sp.p, tri);
+        if spherical { spherical_triangle_pdf(omega) } else { area_pdf_solid_angle(sp.p, tri, x, wi) }
     }
 }
 
