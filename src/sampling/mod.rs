@@ -20,7 +20,7 @@ pub use ltc::{LobeSamples, Ltc, PhongLtc, PhongLtcParameters, phong_ltc_scale_sq
 pub use phong_lobe::{phong_lobe_pdf, phong_lobe_pdf_from_gap, sample_phong_lobe};
 pub use projected_triangle::{
     MIN_ACCEPTANCE, ProjectedPlan, max_cosine, projected_solid_angle, projected_solid_angle_f64,
-    projected_triangle_pdf, sample_projected_triangle,
+    projected_triangle_pdf, sample_projected_triangle, sample_projected_triangle_lanes,
 };
 pub use spherical_triangle::{
     MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA, sample_spherical_triangle, spherical_triangle_area,

@@ -8,9 +8,9 @@
 //! The expected number of trials is `Ω cosmax / Ω⊥`.
 
 use super::spherical_triangle::{MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA};
-use super::{sample_spherical_triangle, spherical_triangle_area};
-use crate::math::SampleRng;
-use glam::{DVec3, Vec3};
+use super::{sample_spherical_triangle, sample_spherical_triangle_lanes, spherical_triangle_area};
+use crate::math::{SampleRng, for_each_lane};
+use glam::{DVec3, Vec2, Vec3};
 
 /// Rejection is used only where it accepts at least this fraction of trials; elsewhere the caller samples area.
 pub const MIN_ACCEPTANCE: f32 = 0.05;
@@ -61,6 +61,43 @@ pub fn sample_projected_triangle(rng: &mut SampleRng, p: Vec3, n: Vec3, tri: [Ve
         }
     }
     None
+}
+
+/// [`sample_projected_triangle`] for the lanes of `lanes` (bit l for lane l), lane l drawing from `rngs[l]`: each
+/// trial's candidates are drawn together ([`sample_spherical_triangle_lanes`]), then each lane accepts or rejects
+/// its own. What `sample_projected_triangle` gives each lane, bit for bit: every lane draws from its stream in the
+/// same order as alone.
+pub fn sample_projected_triangle_lanes(
+    rngs: &mut [SampleRng; 8],
+    lanes: u32,
+    (p, n): (&[Vec3; 8], &[Vec3; 8]),
+    triangles: &[[Vec3; 3]; 8],
+    cos_max: &[f32; 8],
+) -> [Option<Vec3>; 8] {
+    let (mut out, mut u, mut pending) = ([None; 8], [Vec2::ZERO; 8], lanes);
+    if lanes.count_ones() == 1 {
+        // One lane: its trials alone (the same draws, without the others' bookkeeping).
+        let l = lanes.trailing_zeros() as usize;
+        out[l] = sample_projected_triangle(&mut rngs[l], p[l], n[l], triangles[l], cos_max[l]);
+        return out;
+    }
+    for _ in 0..MAX_TRIALS {
+        if pending == 0 {
+            break;
+        }
+        for_each_lane(pending, |l| u[l] = rngs[l].uniform_2d());
+        let drawn = sample_spherical_triangle_lanes(&u, p, triangles, pending);
+        for_each_lane(pending, |l| match drawn[l] {
+            None => pending &= !(1 << l),
+            Some(w) => {
+                if rngs[l].uniform() * cos_max[l] < w.dot(n[l]) {
+                    out[l] = Some(w);
+                    pending &= !(1 << l);
+                }
+            }
+        });
+    }
+    out
 }
 
 /// Density of [`sample_projected_triangle`]: `(ω·n)⁺ / Ω⊥` (solid angle).
@@ -136,6 +173,61 @@ pub fn max_cosine(p: Vec3, n: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
 mod tests {
     use super::*;
     use crate::math::lambert_polygon_irradiance;
+
+    /// Eight lanes draw what the scalar rejection draws, bit for bit, and leave each stream where it leaves it:
+    /// triangles around points with normals at random, through `ProjectedPlan`'s bound of ω·n, lanes left out,
+    /// and single lanes.
+    #[test]
+    fn eight_lanes_draw_what_the_scalar_rejection_draws() {
+        let (mut compared, mut drawn) = (0, 0);
+        for group in 0..6000u64 {
+            let mut setup = SampleRng::new(12, group, 0);
+            let mut point = |scale: f32| {
+                let u = Vec3::new(setup.uniform(), setup.uniform(), setup.uniform()) - 0.5;
+                u * scale
+            };
+            let (mut p, mut n, mut triangles, mut cos_max) =
+                ([Vec3::ZERO; 8], [Vec3::Z; 8], [[Vec3::ZERO; 3]; 8], [0.0; 8]);
+            let mut lanes = 0u32;
+            for l in 0..8 {
+                let size = 10f32.powi((group % 4) as i32 - 2);
+                let centre = point(3.0);
+                triangles[l] = [centre + point(size), centre + point(size), centre + point(size)];
+                p[l] = point(3.0);
+                n[l] = point(2.0).normalize_or(Vec3::Z);
+                let [a, b, c] = triangles[l];
+                if let ProjectedPlan::Rejection { cos_max: bound, .. } = ProjectedPlan::new(p[l], n[l], a, b, c) {
+                    cos_max[l] = bound;
+                    lanes |= 1 << l;
+                }
+            }
+            let lanes = match group % 5 {
+                0 => lanes & 0b0110_1001,
+                1 => lanes & (1 << lanes.trailing_zeros().min(31)),
+                _ => lanes,
+            };
+            let mut rngs: [SampleRng; 8] = std::array::from_fn(|l| SampleRng::new(13, group, l as u64));
+            let mut alone = rngs;
+            let found = sample_projected_triangle_lanes(&mut rngs, lanes, (&p, &n), &triangles, &cos_max);
+            for l in 0..8 {
+                let expected = if lanes & (1 << l) != 0 {
+                    sample_projected_triangle(&mut alone[l], p[l], n[l], triangles[l], cos_max[l])
+                } else {
+                    None
+                };
+                let bits = |w: Option<Vec3>| w.map(|w| w.to_array().map(f32::to_bits));
+                assert_eq!(bits(found[l]), bits(expected), "group {group}, lane {l}");
+                assert_eq!(
+                    rngs[l].uniform().to_bits(),
+                    alone[l].uniform().to_bits(),
+                    "group {group}, lane {l}'s stream"
+                );
+                compared += (lanes >> l) & 1;
+                drawn += expected.is_some() as u32;
+            }
+        }
+        assert!(compared > 10_000 && drawn > 10_000, "{compared} lanes, {drawn} drawn: the test checks too little");
+    }
 
     #[test]
     fn projected_solid_angle_matches_lambert() {

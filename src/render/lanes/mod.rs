@@ -2,16 +2,18 @@
 //! and walk the BVH together (`Accel::occluded_lanes`); traced directions walk the emitters' own tree interleaved,
 //! and their shadow rays go together too. Emitter sampling,
 //! alone or as MIS's light technique, runs in f32x8 ([`emitter`]), and so does the default MIS's BRDF technique
-//! ([`brdf`]); `solid-angle` draws its spherical triangles together in f64x4 ([`solid_angle`]); the other
-//! techniques sample lane by lane.
+//! ([`brdf`]); `solid-angle` and `projected-solid-angle` draw their spherical triangles together in f64x4
+//! ([`solid_angle`], [`projected_solid_angle`]); the other techniques sample lane by lane.
 //! Every lane computes what the one-sample estimator ([`super::estimate_direct`]) computes, in the same order, bit
 //! for bit, so a film does not depend on how its samples were grouped.
 
 mod brdf;
 mod emitter;
+mod projected_solid_angle;
 mod solid_angle;
 
 pub use emitter::{estimate_emitter_lanes, estimate_mis_emitter_brdf_lanes};
+pub use projected_solid_angle::estimate_projected_solid_angle_lanes;
 pub use solid_angle::estimate_solid_angle_lanes;
 
 use super::estimator::{integrand, unshadowed, visible_lanes};

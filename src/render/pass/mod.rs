@@ -4,7 +4,7 @@
 
 use super::lanes::{
     LANES, estimate_emitter_lanes, estimate_guided_lanes, estimate_mis_emitter_brdf_lanes, estimate_mis_lanes,
-    estimate_one_sample_lanes, estimate_solid_angle_lanes,
+    estimate_one_sample_lanes, estimate_projected_solid_angle_lanes, estimate_solid_angle_lanes,
 };
 use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
@@ -373,7 +373,7 @@ impl Renderer {
                 match strategy {
                     Strategy::SolidAngle => estimate_solid_angle_lanes(&ctx, &dirs, &hits, &mut rngs, rays),
                     Strategy::ProjectedSolidAngle => {
-                        estimate_one_sample_lanes(&ctx, &ProjectedSolidAngle, &dirs, &hits, &mut rngs, rays)
+                        estimate_projected_solid_angle_lanes(&ctx, &dirs, &hits, &mut rngs, rays)
                     }
                     _ => estimate_one_sample_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays),
                 }
