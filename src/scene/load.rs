@@ -1,14 +1,14 @@
-//! Loading: scene file (TOML) → OBJ/MTL meshes (tobj) → [`Scene`]. Files are read through a [`Source`]: the
+//! Loading: scene file (TOML) → OBJ meshes (`obj`) and their MTL materials (tobj) → [`Scene`]. Files are read through a [`Source`]: the
 //! file system, or the scenes compiled into the binary.
 
 use super::bundled::{self, BundledScene};
 use super::file::{MaterialOverride, MeshSpec, SceneFile};
 use super::material::validate;
 use super::mtl::clean_mtl;
+use super::obj::read_obj;
 use super::{Camera, Material, Scene, SceneError};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
-use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -141,7 +141,7 @@ impl WorldCamera {
 #[derive(Default)]
 struct Meshes {
     /// The vertices of all meshes in the files' coordinates, f64: rebased and rounded to f32 once every mesh is
-    /// in. Each mesh's vertices are those its triangles use (tobj leaves out the others).
+    /// in. They include those no triangle uses, which neither bound the scene nor need be finite.
     vertices: Vec<DVec3>,
     /// Per triangle, its vertices' indices in `vertices`.
     triangles: Vec<[u32; 3]>,
@@ -159,60 +159,42 @@ impl Meshes {
         let obj_path = PathBuf::from(&spec.obj);
         let obj_dir = obj_path.parent().map(Path::to_path_buf).unwrap_or_default();
         let text = source.read(&obj_path)?;
-        let mtl_error: RefCell<Option<SceneError>> = RefCell::new(None);
-        let mtl_paths: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
-        let warnings: RefCell<Vec<String>> = RefCell::new(Vec::new());
-        let options =
-            tobj::LoadOptions { triangulate: true, ignore_points: true, ignore_lines: true, ..Default::default() };
-        let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |mtl| {
+        let mut mtl_paths: Vec<PathBuf> = Vec::new();
+        let geometry = read_obj(&text, &obj_path, |mtl| {
             let mtl_path = obj_dir.join(mtl);
             let text = match source.read(&mtl_path) {
-                Ok(text) => Some(text),
+                Ok(text) => text,
                 Err(SceneError::Io { path, cause }) if cause.kind() == std::io::ErrorKind::NotFound => {
-                    warnings.borrow_mut().push(format!(
+                    self.warnings.push(format!(
                         "{}: no such MTL file ({}): its materials are replaced by the default grey (k_d = 0.5)",
                         obj_path.display(),
                         path.display()
                     ));
-                    None
+                    String::new()
                 }
-                Err(e) => {
-                    mtl_error.borrow_mut().get_or_insert(e);
-                    return Err(tobj::LoadError::GenericFailure);
-                }
+                Err(e) => return Err(e),
             };
-            let result = clean_mtl(text.as_deref().unwrap_or_default())
-                .map_err(|message| SceneError::Mtl { path: mtl_path.clone(), message })
-                .and_then(|clean| {
-                    if !clean.ignored.is_empty() {
-                        warnings.borrow_mut().push(format!(
-                            "{}: ignored (the Phong model has no use for them): {}",
-                            mtl_path.display(),
-                            clean.ignored.join(", ")
-                        ));
-                    }
-                    tobj::load_mtl_buf(&mut clean.text.as_bytes())
-                        .map_err(|e| SceneError::Mtl { path: mtl_path.clone(), message: e.to_string() })
-                });
-            mtl_paths.borrow_mut().push(mtl_path);
-            result.map_err(|e| {
-                mtl_error.borrow_mut().get_or_insert(e);
-                tobj::LoadError::GenericFailure
-            })
-        })
-        .map_err(|e| SceneError::Obj { path: obj_path.clone(), message: e.to_string() })?;
-        if let Some(e) = mtl_error.into_inner() {
-            return Err(e);
-        }
-        let materials = materials.map_err(|e| SceneError::Mtl { path: obj_path.clone(), message: e.to_string() })?;
-        let mtl_path = mtl_paths.into_inner().pop().unwrap_or_else(|| obj_path.clone());
-        self.warnings.extend(warnings.into_inner());
-        let unknown = unknown_materials(&text, &materials);
-        if !unknown.is_empty() {
+            let clean = clean_mtl(&text).map_err(|message| SceneError::Mtl { path: mtl_path.clone(), message })?;
+            if !clean.ignored.is_empty() {
+                self.warnings.push(format!(
+                    "{}: ignored (the Phong model has no use for them): {}",
+                    mtl_path.display(),
+                    clean.ignored.join(", ")
+                ));
+            }
+            let (materials, _) = tobj::load_mtl_buf(&mut clean.text.as_bytes())
+                .map_err(|e| SceneError::Mtl { path: mtl_path.clone(), message: e.to_string() })?;
+            mtl_paths.push(mtl_path);
+            Ok(materials)
+        })?;
+        drop(text);
+        let materials = &geometry.materials;
+        let mtl_path = mtl_paths.pop().unwrap_or_else(|| obj_path.clone());
+        if !geometry.unknown_materials.is_empty() {
             self.warnings.push(format!(
                 "{}: usemtl of material(s) no MTL defines ({}): those faces get the default grey (k_d = 0.5)",
                 obj_path.display(),
-                unknown.join(", ")
+                geometry.unknown_materials.join(", ")
             ));
         }
 
@@ -229,7 +211,7 @@ impl Meshes {
             }
         }
         let base = self.materials.len() as u32;
-        for m in &materials {
+        for m in materials {
             // Bad values are reported against the file that wrote them: the MTL, or the scene file's override.
             let blame =
                 |path: &Path, e: SceneError| SceneError::Mesh { path: path.to_path_buf(), message: e.to_string() };
@@ -240,27 +222,35 @@ impl Meshes {
             self.names.push(m.name.clone());
         }
 
-        for model in &models {
-            let mesh = &model.mesh;
-            if let Some(i) = mesh.positions.iter().position(|x| !x.is_finite()) {
-                return Err(SceneError::Mesh {
-                    path: obj_path,
-                    message: format!("vertex {} of object '{}' is not finite (NaN or infinity)", i / 3 + 1, model.name),
-                });
+        // Only the vertices some triangle uses need be finite.
+        let positions = &geometry.positions;
+        let not_finite = geometry.triangles.par_iter().enumerate().find_map_first(|(t, corners)| {
+            corners.iter().find(|&&i| !positions[i as usize].is_finite()).map(|&i| (t, i))
+        });
+        if let Some((t, i)) = not_finite {
+            let run = geometry.runs.iter().rev().find(|r| r.first <= t).expect("the first run starts at 0");
+            return Err(SceneError::Mesh {
+                path: obj_path,
+                message: format!("vertex {} of object '{}' is not finite (NaN or infinity)", i + 1, run.object),
+            });
+        }
+        if self.vertices.len() + positions.len() > u32::MAX as usize {
+            return Err(SceneError::Mesh { path: obj_path, message: "more than 2³² vertices in the scene".into() });
+        }
+        let first = self.vertices.len() as u32;
+        self.vertices.extend_from_slice(positions);
+        self.triangles.extend(geometry.triangles.iter().map(|t| t.map(|i| first + i)));
+        for (r, run) in geometry.runs.iter().enumerate() {
+            let end = geometry.runs.get(r + 1).map_or(geometry.triangles.len(), |next| next.first);
+            if end == run.first {
+                continue;
             }
-            let material = match mesh.material_id {
-                Some(id) if id < materials.len() => base + id as u32,
-                _ => self.default_material(),
+            let material = match run.material {
+                Some(id) => base + id as u32,
+                None => self.default_material(),
             };
-            if self.vertices.len() + mesh.positions.len() / 3 > u32::MAX as usize {
-                return Err(SceneError::Mesh {
-                    path: obj_path, message: "more than 2³² vertices in the scene".into()
-                });
-            }
-            let first = self.vertices.len() as u32;
-            self.vertices.extend(mesh.positions.chunks_exact(3).map(|p| DVec3::new(p[0], p[1], p[2])));
-            self.triangles.extend(mesh.indices.chunks_exact(3).map(|f| [first + f[0], first + f[1], first + f[2]]));
-            self.material_ids.resize(self.triangles.len(), material);
+            let count = self.material_ids.len() + end - run.first;
+            self.material_ids.resize(count, material);
         }
         Ok(())
     }
@@ -273,9 +263,17 @@ impl Meshes {
         })
     }
 
-    /// The vertices' bounding box (infinite and inverted when there is none).
+    /// The bounding box of the vertices the triangles use (infinite and inverted when there is none).
     fn bounds(&self) -> (DVec3, DVec3) {
-        self.vertices.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| (lo.min(*v), hi.max(*v)))
+        let empty = || (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        self.triangles
+            .par_iter()
+            .fold(empty, |(lo, hi), t| {
+                t.iter().fold((lo, hi), |(lo, hi), &i| {
+                    (lo.min(self.vertices[i as usize]), hi.max(self.vertices[i as usize]))
+                })
+            })
+            .reduce(empty, |(lo, hi), (l, h)| (lo.min(l), hi.max(h)))
     }
 
     /// Rebases a scene far from the origin (by more than 16 times its size) to its bounds' centre, in f64, then
@@ -329,94 +327,5 @@ fn auto_camera((lo, hi): (DVec3, DVec3)) -> WorldCamera {
         fov_y,
         width: 512,
         height: 512,
-    }
-}
-
-/// The names an OBJ's `usemtl` lines use that none of its materials has, each once. A `usemtl` line is one whose
-/// first word is `usemtl`, before any `#`; its name is the rest of the line up to a `#`, trimmed. The text is
-/// searched for the word rather than read line by line: a 1M-triangle OBJ has some 1.5 million lines and often a
-/// handful of `usemtl`s.
-fn unknown_materials(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
-    let mut unknown: Vec<String> = Vec::new();
-    for (at, _) in obj.match_indices("usemtl") {
-        let line_start = obj[..at].rfind('\n').map_or(0, |i| i + 1);
-        let rest = &obj[at + "usemtl".len()..];
-        let rest = &rest[..rest.find('\n').unwrap_or(rest.len())];
-        let rest = rest.split('#').next().unwrap_or("");
-        if !obj[line_start..at].chars().all(char::is_whitespace) || !rest.starts_with(char::is_whitespace) {
-            continue;
-        }
-        let name = rest.trim();
-        if !name.is_empty() && !materials.iter().any(|m| m.name == name) && !unknown.iter().any(|u| u == name) {
-            unknown.push(name.to_string());
-        }
-    }
-    unknown
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `unknown_materials` as its doc says it, line by line.
-    fn unknown_line_by_line(obj: &str, materials: &[tobj::Material]) -> Vec<String> {
-        let mut unknown: Vec<String> = Vec::new();
-        for line in obj.lines() {
-            let line = line.split('#').next().unwrap_or("").trim();
-            if let Some(name) =
-                line.strip_prefix("usemtl").filter(|r| r.starts_with(char::is_whitespace)).map(str::trim)
-                && !name.is_empty()
-                && !materials.iter().any(|m| m.name == name)
-                && !unknown.iter().any(|u| u == name)
-            {
-                unknown.push(name.to_string());
-            }
-        }
-        unknown
-    }
-
-    #[test]
-    fn the_unknown_materials_found_by_searching_are_those_of_every_line() {
-        let known = ["red", "white"].map(|name| tobj::Material { name: name.into(), ..Default::default() });
-        let lines = [
-            "usemtl red",
-            "usemtl blue",
-            "  usemtl\tgreen  ",
-            "usemtl green",
-            "# usemtl commented",
-            "xusemtl mixed",
-            "usemtlglued",
-            "usemtl",
-            "usemtl   ",
-            "usemtl # nothing",
-            "usemtl gold # shiny",
-            "usemtlusemtl twice",
-            "v 0 0 0",
-            "f 1 2 3",
-            "usemtl white\r",
-            "\u{a0}usemtl nbsp",
-            "usemtl two words",
-            "g usemtl not first",
-            "",
-            "usemtl blue",
-        ];
-        let mut checked = 0;
-        // Every line alone and at the start, the middle and the end of a file, with and without a final newline.
-        for (i, line) in lines.iter().enumerate() {
-            for obj in [
-                line.to_string(),
-                format!("{line}\n"),
-                format!("v 1 2 3\n{line}\nf 1 1 1"),
-                format!("{}\n{line}", lines[(i + 7) % lines.len()]),
-                lines.join("\n"),
-                lines[i..].join("\r\n"),
-            ] {
-                assert_eq!(unknown_materials(&obj, &known), unknown_line_by_line(&obj, &known), "{obj:?}");
-                checked += 1;
-            }
-        }
-        let all = lines.join("\n");
-        assert_eq!(unknown_materials(&all, &known), ["blue", "green", "gold", "nbsp", "two words"]);
-        assert_eq!(checked, 6 * lines.len());
     }
 }

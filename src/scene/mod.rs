@@ -12,6 +12,7 @@ mod file;
 mod load;
 mod material;
 mod mtl;
+mod obj;
 
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
