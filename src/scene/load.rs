@@ -1,5 +1,5 @@
-//! Loading: scene file (TOML) → OBJ meshes (`obj`) and their MTL materials (tobj) → [`Scene`]. Files are read through a [`Source`]: the
-//! file system, or the scenes compiled into the binary.
+//! Loading: scene file (TOML) → OBJ meshes (`obj`, on all cores) and their MTL materials (tobj) → [`Scene`].
+//! Files are read through a [`Source`]: the file system, or the scenes compiled into the binary.
 
 use super::bundled::{self, BundledScene};
 use super::file::{MaterialOverride, MeshSpec, SceneFile};
