@@ -11,7 +11,7 @@ use illumlab::render::{
     Film, Footprint, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
     write_image,
 };
-use illumlab::scene::{LightSelection, Scene, load_scene};
+use illumlab::scene::{LightSelection, Scene, load_scene, vector_path};
 use illumlab::session::views::View;
 use illumlab::session::worker::Budget;
 use std::path::PathBuf;
@@ -346,12 +346,13 @@ fn render(args: RenderArgs) -> Result<()> {
         print_training(training);
     }
     println!(
-        "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped -> {}",
+        "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped, shadow rays in {} -> {}",
         args.spp,
         seconds,
         stats.samples as f64 / seconds / 1e6,
         stats.rays as f64 / seconds / 1e6,
         stats.non_finite,
+        vector_path().name(),
         args.output.display()
     );
     Ok(())

@@ -16,7 +16,7 @@ mod obj;
 
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
-pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE};
+pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, VectorPath, has_avx512, vector_path};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};

@@ -7,7 +7,7 @@ use wide::{CmpEq, CmpLe, CmpLt, f32x8, i32x8};
 
 /// `1 + 2γ₃` with `γₙ = nε/(1 − nε)`, ε = 2⁻²⁴: scaling the exit distance by it makes the slab test
 /// conservative under float rounding (Ize 2013), so no ray slips between a box and the triangle inside it.
-const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(super) const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// The least a box is widened by on each side.
 const PAD_NEAR_ZERO: f32 = 1e-20;
@@ -105,7 +105,14 @@ impl Node8 {
         (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
     }
 
-    /// Bit i set when lane i holds a child.
+    /// min x, min y, min z, max x, max y, max z of the children's boxes, child k in lane k.
+    #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+    #[inline(always)]
+    pub fn bounds(&self) -> &[f32x8; 6] {
+        &self.bounds
+    }
+
+    /// Bit i set when lane i holds a child (the first ones).
     #[inline(always)]
     pub fn used(&self) -> u32 {
         self.used

@@ -171,6 +171,13 @@ impl TrianglePacket {
         hit
     }
 
+    /// v₀, e₁ and e₂ of the eight lanes.
+    #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+    #[inline(always)]
+    pub fn edges(&self) -> (&[f32x8; 3], &[f32x8; 3], &[f32x8; 3]) {
+        (&self.v0, &self.e1, &self.e2)
+    }
+
     /// Whether any triangle is hit at `0 < t < t_max`.
     #[inline(always)]
     pub fn any(&self, ray: &WideRay, t_max: f32) -> bool {

@@ -1,7 +1,9 @@
 //! A ray broadcast to eight SIMD lanes, or eight rays one per lane, with what the slab test needs precomputed
-//! once per ray.
+//! once per ray; and the tests eight rays walking together run ([`BundleTests`]).
 
-use crate::math::Vec3x8;
+use super::node::Node8;
+use super::packet::TrianglePacket;
+use crate::math::{Vec3x8, for_each_lane};
 use glam::{Vec3, Vec3A};
 use wide::{CmpLt, f32x8};
 
@@ -57,5 +59,30 @@ impl RayLanes {
         // The sign bit of 1/d, spread over the lane: an arithmetic shift of the bits.
         let negative = inv_d.map(|inv| bytemuck::cast(bytemuck::cast::<f32x8, wide::i32x8>(inv) >> 31));
         Self { o: [origins.x, origins.y, origins.z], d, inv_d, negative }
+    }
+}
+
+/// The tests the eight rays of a shared walk (`Accel::occluded_lanes`) run at its nodes and leaves: in eight
+/// lanes ([`RayLanes`]) or in sixteen (`super::avx512`), with the same answers bit for bit.
+pub(super) trait BundleTests {
+    /// Which of the rays enter each used child of `node` within `t_max`: child k's in bits 8k to 8k + 7 (bit
+    /// 8k + i for ray i), as [`Node8::intersect_lanes`] gives them.
+    fn entered(&self, node: &Node8, t_max: f32) -> u64;
+
+    /// [`TrianglePacket::any_of_rays`]: the rays that hit one of the packet's triangles at `0 < t < t_max`.
+    fn any_of_rays(&self, packet: &TrianglePacket, t_max: f32) -> u32;
+}
+
+impl BundleTests for RayLanes {
+    #[inline(always)]
+    fn entered(&self, node: &Node8, t_max: f32) -> u64 {
+        let mut entered = 0;
+        for_each_lane(node.used(), |k| entered |= (node.intersect_lanes(k, self, t_max) as u64) << (8 * k));
+        entered
+    }
+
+    #[inline(always)]
+    fn any_of_rays(&self, packet: &TrianglePacket, t_max: f32) -> u32 {
+        packet.any_of_rays(self, t_max)
     }
 }

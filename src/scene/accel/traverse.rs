@@ -4,10 +4,13 @@
 //! samples of one pixel): each node's children are tested against all of them at once, and a ray drops out
 //! when it is found occluded; where too few of them enter a subtree, they walk on alone but interleaved.
 
+#[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+use super::avx512;
 use super::build::MAX_DEPTH;
 use super::node::{Child, SKIP_NOTHING};
 use super::packet::NearestLanes;
-use super::ray::{RayLanes, WideRay};
+use super::ray::{BundleTests, RayLanes, WideRay};
+use super::vectors::{VectorPath, vector_path};
 use super::{Accel, Hit, HitLanes};
 use crate::math::{Vec3x8, for_each_lane};
 use arrayvec::ArrayVec;
@@ -262,6 +265,21 @@ impl Accel {
     /// different places), they all walk alone together.
     #[inline]
     pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32, skips: [u32; 8]) -> u32 {
+        self.occluded_lanes_on(vector_path(), origins, dirs, t_max, active, skips)
+    }
+
+    /// [`Accel::occluded_lanes`] with the shared walk's tests in `path`'s vectors (the same answers on every
+    /// path; [`VectorPath::Avx512`] only where the CPU has it, or this panics).
+    #[inline]
+    pub fn occluded_lanes_on(
+        &self,
+        path: VectorPath,
+        origins: &Vec3x8,
+        dirs: &Vec3x8,
+        t_max: f32,
+        active: u32,
+        skips: [u32; 8],
+    ) -> u32 {
         let Some(root) = self.root else { return 0 };
         let skips = skips.map(|s| s as i32);
         let mut alone: [AnyHitStack; 8] = Default::default();
@@ -270,10 +288,33 @@ impl Accel {
             return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
         }
         let rays = RayLanes::new(origins, dirs);
+        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+        if path == VectorPath::Avx512 {
+            let walk = |tests: &_| self.walk_shared(root, active, tests, t_max, &skips, &mut alone, origins, dirs);
+            return avx512::occluded_lanes(walk, &rays);
+        }
+        let _ = path; // one path only in builds without the 16-lane code
+        self.walk_shared(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
+    }
+
+    /// The shared walk of [`Accel::occluded_lanes`], its nodes and leaves tested by `tests`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn walk_shared(
+        &self,
+        root: Child,
+        active: u32,
+        tests: &impl BundleTests,
+        t_max: f32,
+        skips: &[i32; 8],
+        alone: &mut [AnyHitStack; 8],
+        origins: &Vec3x8,
+        dirs: &Vec3x8,
+    ) -> u32 {
         if skips.iter().any(|&s| s != SKIP_NOTHING) {
-            self.walk_together::<true>(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
+            self.walk_together::<true>(root, active, tests, t_max, skips, alone, origins, dirs)
         } else {
-            self.walk_together::<false>(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
+            self.walk_together::<false>(root, active, tests, t_max, skips, alone, origins, dirs)
         }
     }
 
@@ -284,7 +325,7 @@ impl Accel {
         &self,
         root: Child,
         active: u32,
-        rays: &RayLanes,
+        tests: &impl BundleTests,
         t_max: f32,
         skips: &[i32; 8],
         alone: &mut [AnyHitStack; 8],
@@ -319,7 +360,7 @@ impl Accel {
             }
             if current.is_leaf() {
                 for packet in &self.packets[current.first as usize..(current.first + current.packets) as usize] {
-                    let hit = packet.any_of_rays(rays, t_max) & lanes;
+                    let hit = tests.any_of_rays(packet, t_max) & lanes;
                     occluded |= hit;
                     lanes &= !hit;
                     if lanes == 0 {
@@ -332,11 +373,12 @@ impl Accel {
                 continue;
             }
             let node = &self.nodes[current.first as usize];
+            let entered_children = tests.entered(node, t_max);
             let mut children = node.used();
             while children != 0 {
                 let k = children.trailing_zeros() as usize;
                 children &= children - 1;
-                let mut entered = node.intersect_lanes(k, rays, t_max) & lanes;
+                let mut entered = (entered_children >> (8 * k)) as u32 & 0xff & lanes;
                 if SKIPS {
                     let group = self.groups[current.first as usize].group(k);
                     entered &= !(skip_lanes.cmp_eq(i32x8::splat(group)).move_mask() as u32);
