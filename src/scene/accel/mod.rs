@@ -13,6 +13,7 @@ mod frustum;
 mod node;
 mod packet;
 mod ray;
+mod shadow_bundle;
 mod traverse;
 mod vectors;
 
