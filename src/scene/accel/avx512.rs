@@ -48,6 +48,8 @@ impl RayLanes512 {
 }
 
 impl BundleTests for RayLanes512 {
+    const PATH: super::vectors::VectorPath = super::vectors::VectorPath::Avx512;
+
     #[inline(always)]
     fn entered(&self, node: &Node8, t_max: f32) -> u64 {
         // SAFETY: a `RayLanes512` is made only inside `with_avx512`, which runs only where the CPU has AVX-512.

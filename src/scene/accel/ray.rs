@@ -65,6 +65,9 @@ impl RayLanes {
 /// The tests the eight rays of a shared walk (`Accel::occluded_lanes`) run at its nodes and leaves: in eight
 /// lanes ([`RayLanes`]) or in sixteen (`super::avx512`), with the same answers bit for bit.
 pub(super) trait BundleTests {
+    /// The vector instructions these tests run with.
+    const PATH: super::vectors::VectorPath;
+
     /// Which of the rays enter each used child of `node` within `t_max`: child k's in bits 8k to 8k + 7 (bit
     /// 8k + i for ray i), as [`Node8::intersect_lanes`] gives them.
     fn entered(&self, node: &Node8, t_max: f32) -> u64;
@@ -74,6 +77,8 @@ pub(super) trait BundleTests {
 }
 
 impl BundleTests for RayLanes {
+    const PATH: super::vectors::VectorPath = super::vectors::VectorPath::Avx2;
+
     #[inline(always)]
     fn entered(&self, node: &Node8, t_max: f32) -> u64 {
         let mut entered = 0;

@@ -15,11 +15,6 @@ use crate::math::{Vec3x8, for_each_lane};
 use arrayvec::ArrayVec;
 use wide::{CmpEq, i32x8};
 
-/// Rays walk a subtree together while at least this many of them enter it; fewer go on alone, since a
-/// node costs the bundle eight box tests whatever the number of rays still in it (Benthin et al., "Combining
-/// Single and Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture", 2012).
-const PACKET_MIN_RAYS: u32 = 5;
-
 /// Subtrees set aside per ray in [`Accel::occluded_lanes`] before the rays walk alone.
 pub(super) const SET_ASIDE: usize = 8;
 
@@ -29,7 +24,7 @@ impl Accel {
     /// the leaves its own slab tests admit and meets their triangles through the same arithmetic as alone, so
     /// its answer is [`Accel::occluded`]'s, bit for bit.
     ///
-    /// The rays share the walk while at least `PACKET_MIN_RAYS` of them enter a subtree: the tests of a node's
+    /// The rays share the walk while at least [`VectorPath::packet_min_rays`] of them enter a subtree: the tests of a node's
     /// children for all of them are independent and overlap. A subtree fewer rays enter is set aside on the
     /// stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
     /// (`Accel::walk_alone`): before the shared walk goes on with one of them (it may be occluded by then), when
@@ -55,7 +50,7 @@ impl Accel {
         let Some(root) = self.root else { return 0 };
         let skips = skips.map(|s| s as i32);
         let mut alone: [AnyHitStack; 8] = Default::default();
-        if active.count_ones() < PACKET_MIN_RAYS {
+        if active.count_ones() < path.packet_min_rays() {
             for_each_lane(active, |l| alone[l].push(root));
             return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
         }
@@ -84,20 +79,20 @@ impl Accel {
         dirs: &Vec3x8,
     ) -> u32 {
         if skips.iter().any(|&s| s != SKIP_NOTHING) {
-            self.walk_together::<true>(root, active, tests, t_max, skips, alone, origins, dirs)
+            self.walk_together::<true, _>(root, active, tests, t_max, skips, alone, origins, dirs)
         } else {
-            self.walk_together::<false>(root, active, tests, t_max, skips, alone, origins, dirs)
+            self.walk_together::<false, _>(root, active, tests, t_max, skips, alone, origins, dirs)
         }
     }
 
     /// The shared walk of [`Accel::occluded_lanes`], with the rays' groups to skip tested only if `SKIPS`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn walk_together<const SKIPS: bool>(
+    fn walk_together<const SKIPS: bool, T: BundleTests>(
         &self,
         root: Child,
         active: u32,
-        tests: &impl BundleTests,
+        tests: &T,
         t_max: f32,
         skips: &[i32; 8],
         alone: &mut [AnyHitStack; 8],
@@ -111,7 +106,7 @@ impl Accel {
         stack.push((root, active));
         while let Some((current, lanes)) = stack.pop() {
             let mut lanes = lanes & !occluded;
-            let few = lanes.count_ones() < PACKET_MIN_RAYS;
+            let few = lanes.count_ones() < T::PATH.packet_min_rays();
             // Rays about to go on together, or to set one more subtree aside, first walk alone.
             let walk_first = if few { full } else { set_aside };
             if lanes & walk_first != 0 {

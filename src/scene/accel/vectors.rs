@@ -22,6 +22,20 @@ impl VectorPath {
             Self::Avx512 => "16 lanes (AVX-512)",
         }
     }
+
+    /// Rays walk a subtree together while at least this many of them enter it; fewer go on alone, since a node
+    /// costs the bundle its children's box tests whatever the number of rays still in it (Benthin et al.,
+    /// "Combining Single and Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture",
+    /// 2012). Sixteen lanes test two children per vector, so the shared walk pays off with fewer rays: measured
+    /// on an Intel Xeon (AVX-512) with every room's leaves split (2026-12-05), 2 rather than 5 made the Cornell
+    /// box's `emitter` about 6% faster and the knot's 3–10%; on the eight-lane path 5 was kept (3 and 7: within
+    /// 0.2% and +3% instructions on an AMD EPYC, 2026-12-02; this Xeon's eight-lane timings did not decide).
+    pub fn packet_min_rays(self) -> u32 {
+        match self {
+            Self::Avx2 => 5,
+            Self::Avx512 => 2,
+        }
+    }
 }
 
 /// The path this process runs: AVX-512 where the CPU has it, unless `ILLUMLAB_VECTORS=avx2`. Decided once.
