@@ -1,7 +1,8 @@
 //! The reference as the worker renders it: from a file, from the cache, or pass by pass between the lanes' passes,
 //! then stored in the cache.
 
-use super::{A, ReferenceStatus, State};
+use super::state::State;
+use super::{A, ReferenceStatus};
 use crate::measure::{Reference, ReferenceOrigin, load_cached, reference_settings, store_cached};
 use crate::render::{Film, Renderer};
 use std::path::PathBuf;

@@ -2,8 +2,10 @@
 
 use super::*;
 use crate::measure::{Reference, ReferenceOrigin};
-use crate::render::Strategy;
+use crate::render::{Film, Renderer, Strategy};
 use crate::scene::load_scene;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 fn wait_for(worker: &Worker, pred: impl Fn(&Frame) -> bool) -> Arc<Frame> {
     wait_for_lane(worker, A, pred)
