@@ -349,7 +349,7 @@ mod tests {
     }
 
     /// The SAH with the large leaves' traversal cost splits the Cornell box's leaf of its back wall and two faces
-    /// of the tall block (a box of 70% of the room's half area, which nearly every shadow ray from the back half
+    /// of the tall block (a box of 71% of the room's half area, which nearly every shadow ray from the back half
     /// of the room enters), and leaves the knot's fine mesh as the preset has it, leaf for leaf.
     #[test]
     fn large_leaves_are_split_where_small_ones_are_not() {

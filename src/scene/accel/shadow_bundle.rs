@@ -24,9 +24,9 @@ impl Accel {
     /// the leaves its own slab tests admit and meets their triangles through the same arithmetic as alone, so
     /// its answer is [`Accel::occluded`]'s, bit for bit.
     ///
-    /// The rays share the walk while at least [`VectorPath::packet_min_rays`] of them enter a subtree: the tests of a node's
-    /// children for all of them are independent and overlap. A subtree fewer rays enter is set aside on the
-    /// stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
+    /// The rays share the walk while at least [`VectorPath::packet_min_rays`] of them enter a subtree: the tests
+    /// of a node's children for all of them are independent and overlap. A subtree fewer rays enter is set aside
+    /// on the stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
     /// (`Accel::walk_alone`): before the shared walk goes on with one of them (it may be occluded by then), when
     /// one has `SET_ASIDE` subtrees set aside, and at the end. Where the rays part at the root (lights in
     /// different places), they all walk alone together.
