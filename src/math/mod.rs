@@ -1,5 +1,5 @@
-//! Pure math: orthonormal frames, robust ray origins, seeded per-sample randomness, spherical geometry and
-//! eight-lane vectors.
+//! Pure math: orthonormal frames, robust ray origins, seeded per-sample randomness, spherical geometry,
+//! eight-lane vectors and the samplers' sin and cos.
 
 mod equal_area;
 mod frame;
@@ -7,6 +7,7 @@ mod offset;
 mod phong_polygon;
 mod polygon;
 mod rng;
+mod trig;
 mod vec3x8;
 
 pub use equal_area::{SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk};
@@ -15,6 +16,7 @@ pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};
 pub use phong_polygon::phong_polygon_moment;
 pub use polygon::lambert_polygon_irradiance;
 pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes, hash_ray, mix64};
+pub use trig::{sin_cos, sin_cos_lanes};
 pub use vec3x8::Vec3x8;
 
 /// Reflects `w` about the unit normal `n`: ω_r = 2 (n·ω) n − ω (the lecture's mirror direction).

@@ -1,5 +1,6 @@
 //! Hemisphere warps in the local frame (z = n).
 
+use crate::math::sin_cos;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -9,8 +10,8 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 pub fn sample_uniform_hemisphere(u: Vec2) -> Vec3 {
     let z = u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = sin_cos(2.0 * PI * u.y);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 /// Density of [`sample_uniform_hemisphere`]: `1/(2π)` on z ≥ 0 (solid angle).
@@ -44,7 +45,8 @@ fn sample_concentric_disc(u: Vec2) -> Vec2 {
     }
     let (r, theta) =
         if o.x.abs() > o.y.abs() { (o.x, FRAC_PI_4 * (o.y / o.x)) } else { (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y)) };
-    r * Vec2::new(theta.cos(), theta.sin())
+    let (sin, cos) = sin_cos(theta);
+    r * Vec2::new(cos, sin)
 }
 
 #[cfg(test)]

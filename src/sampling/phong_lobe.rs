@@ -1,5 +1,6 @@
 //! The specular lobe of the lecture's Phong BRDF, sampled around the mirror direction ω_r.
 
+use crate::math::sin_cos;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -13,8 +14,8 @@ pub fn sample_phong_lobe(u: Vec2, alpha: f32) -> Vec3 {
     let gap = (-(u.x.ln() / (alpha + 1.0)).exp_m1()).clamp(0.0, 1.0); // 1 − cos θ_r
     let cos_theta = 1.0 - gap;
     let sin_theta = (gap * (2.0 - gap)).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+    let (sin_phi, cos_phi) = sin_cos(2.0 * PI * u.y);
+    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
 }
 
 /// Density of [`sample_phong_lobe`] at cos θ_r: `(α+1)/(2π) max(0, cos θ_r)^α` (solid angle).

@@ -1,12 +1,12 @@
 //! Phong BRDF sampling ([`crate::render::strategy::Brdf`]) for up to eight shading points at once: the lobe
 //! choice, the cosine-weighted and the cos^α samples, the frames around n and ω_r, the mixture's density
-//! `p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α` and f_r run in f32x8. The transcendental functions (sin
-//! and cos of the sample's angle, the lobe's ln and expm1, the density's `cos^α`) are the scalar code's own calls,
-//! lane by lane, and every other operation is the scalar code's, in its order and without fused multiply-adds
+//! `p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α` and f_r run in f32x8, the sample's angle's sin and cos
+//! too (`crate::math::sin_cos_lanes`, the scalar samplers' own arithmetic). The other transcendental functions
+//! (the lobe's ln and expm1, the density's `cos^α`) are the scalar code's own calls, lane by lane, and every other operation is the scalar code's, in its order and without fused multiply-adds
 //! (as [`Vec3x8`]'s): each lane gets what `Brdf::sample` and `eval_brdf` give it, bit for bit.
 
 use super::LANES;
-use crate::math::{ONE_MINUS_EPSILON, SampleRng, Vec3x8, for_each_lane};
+use crate::math::{ONE_MINUS_EPSILON, SampleRng, Vec3x8, for_each_lane, sin_cos_lanes};
 use crate::render::ShadingPoint;
 use crate::sampling::phong_lobe_pdf_from_gap;
 use glam::Vec3;
@@ -65,25 +65,22 @@ pub(super) fn sample_brdf_lanes(shading: &[Option<ShadingPoint>; LANES], rngs: &
     let theta = x_wider
         .blend(f32x8::splat(FRAC_PI_4) * (o_y / o_x), f32x8::splat(FRAC_PI_2) - f32x8::splat(FRAC_PI_4) * (o_x / o_y));
     let centre = o_x.cmp_eq(zero) & o_y.cmp_eq(zero);
-    let theta = theta.as_array_ref();
-    let (mut cos_theta, mut sin_theta) = ([0.0; LANES], [0.0; LANES]);
-    for_each_lane(diffuse_lanes, |l| (cos_theta[l], sin_theta[l]) = (theta[l].cos(), theta[l].sin()));
-    let disc_x = centre.blend(zero, radius * f32x8::new(cos_theta));
-    let disc_y = centre.blend(zero, radius * f32x8::new(sin_theta));
+    let (sin_theta, cos_theta) = sin_cos_lanes(theta);
+    let disc_x = centre.blend(zero, radius * cos_theta);
+    let disc_y = centre.blend(zero, radius * sin_theta);
     let height = (one - (disc_x * disc_x + disc_y * disc_y)).max(zero).sqrt();
     let cosine_sample = Vec3x8::new(disc_x, disc_y, height);
 
     // Glossy: the cos^α lobe around ω_r (`sample_phong_lobe`): 1 − cos θ_r = −expm1(ln u₀ / (α+1)).
     let u0_lanes = u0.as_array_ref();
-    let (mut gap, mut cos_phi, mut sin_phi) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-    let phi = (f32x8::splat(2.0 * PI) * u_y).to_array();
+    let mut gap = [0.0; LANES];
     for_each_lane(drawn & !diffuse_lanes, |l| {
         gap[l] = (-(u0_lanes[l].ln() / (alpha[l] + 1.0)).exp_m1()).clamp(0.0, 1.0);
-        (cos_phi[l], sin_phi[l]) = (phi[l].cos(), phi[l].sin());
     });
+    let (sin_phi, cos_phi) = sin_cos_lanes(f32x8::splat(2.0 * PI) * u_y);
     let gap = f32x8::new(gap);
     let sin_theta_r = (gap * (f32x8::splat(2.0) - gap)).max(zero).sqrt();
-    let lobe_sample = Vec3x8::new(sin_theta_r * f32x8::new(cos_phi), sin_theta_r * f32x8::new(sin_phi), one - gap);
+    let lobe_sample = Vec3x8::new(sin_theta_r * cos_phi, sin_theta_r * sin_phi, one - gap);
 
     // Into the world: about n (diffuse) or ω_r = 2(n·ω_o)n − ω_o (glossy).
     let wr = n * (f32x8::splat(2.0) * n.dot(wo)) - wo;
