@@ -83,6 +83,18 @@ impl SampleRngLanes {
         f32x8::new(u)
     }
 
+    /// These streams, but those of `lanes` (bit i for stream i) as `before`'s after `n` more uniforms: where a
+    /// sample drew fewer uniforms than the others since `before`.
+    #[inline(always)]
+    pub fn with_lanes_after(mut self, before: &Self, lanes: u32, n: usize) -> Self {
+        for (i, state) in self.state.iter_mut().enumerate() {
+            if lanes & (1 << i) != 0 {
+                *state = before.lane(i).after_uniforms(n).state;
+            }
+        }
+        self
+    }
+
     /// Stream i, to go on alone.
     #[inline(always)]
     pub fn lane(&self, i: usize) -> SampleRng {
@@ -179,6 +191,23 @@ mod tests {
             }
             let mut skipped = SampleRng::new(3, 17, 5).after_uniforms(n);
             assert!((0..4).all(|_| drawn.uniform().to_bits() == skipped.uniform().to_bits()), "n = {n}");
+        }
+    }
+
+    /// Lanes taken from the streams before, n uniforms on, go on as those streams after n uniforms; the others
+    /// are left as they were.
+    #[test]
+    fn lanes_after_fewer_uniforms_go_on_from_there() {
+        let before = PixelStreams::new(9, 4).samples(16);
+        let mut now = before;
+        for _ in 0..3 {
+            now.uniform();
+        }
+        let mixed = now.with_lanes_after(&before, 0b1010_0110, 1);
+        for i in 0..8 {
+            let expected = if 0b1010_0110 & (1 << i) != 0 { before.lane(i).after_uniforms(1) } else { now.lane(i) };
+            let (mut a, mut b) = (mixed.lane(i), expected);
+            assert!((0..4).all(|_| a.uniform().to_bits() == b.uniform().to_bits()), "lane {i}");
         }
     }
 

@@ -15,6 +15,8 @@ pub struct Vec3x8 {
 }
 
 impl Vec3x8 {
+    pub const ZERO: Self = Self { x: f32x8::ZERO, y: f32x8::ZERO, z: f32x8::ZERO };
+
     #[inline(always)]
     pub fn splat(v: Vec3) -> Self {
         Self { x: f32x8::splat(v.x), y: f32x8::splat(v.y), z: f32x8::splat(v.z) }

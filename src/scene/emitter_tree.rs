@@ -6,6 +6,7 @@
 //! hemisphere), and those are answered here without walking the scene's tree.
 
 use super::{Accel, Hit, Triangle};
+use crate::math::Vec3x8;
 use glam::Vec3;
 
 /// A BVH over the scene's emitter triangles whose hits name triangles in the scene's order.
@@ -36,6 +37,12 @@ impl EmitterTree {
     #[inline]
     pub fn closest_hits(&self, rays: &[(Vec3, Vec3); 8], active: u32) -> [Option<Hit>; 8] {
         self.accel.closest_hits(rays, active, f32::INFINITY).map(|h| h.map(|h| self.in_scene(h)))
+    }
+
+    /// [`EmitterTree::closest_hits`] for rays given as lanes: ray l is `origins + t·dirs` in lane l.
+    #[inline]
+    pub fn closest_hits_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, active: u32) -> [Option<Hit>; 8] {
+        self.accel.closest_hits_lanes(origins, dirs, active, f32::INFINITY).map(|h| h.map(|h| self.in_scene(h)))
     }
 
     #[inline(always)]

@@ -6,7 +6,7 @@
 //! (as [`Vec3x8`]'s): each lane gets what `Brdf::sample` and `eval_brdf` give it, bit for bit.
 
 use super::LANES;
-use crate::math::{ONE_MINUS_EPSILON, SampleRng, Vec3x8, for_each_lane, sin_cos_lanes};
+use crate::math::{ONE_MINUS_EPSILON, SampleRngLanes, Vec3x8, for_each_lane, sin_cos_lanes};
 use crate::render::ShadingPoint;
 use crate::sampling::phong_lobe_pdf_from_gap;
 use glam::Vec3;
@@ -14,9 +14,8 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 use wide::{CmpEq, CmpGt, CmpLt, f32x8};
 
 /// Per lane, a direction drawn from its material's BRDF mixture with what the estimator needs of it.
-#[derive(Default)]
 pub(super) struct BrdfSamples {
-    pub wi: [Vec3; LANES],
+    pub wi: Vec3x8,
     /// The mixture's density at ω_i (solid angle).
     pub pdf: [f32; LANES],
     /// `f_r(ω_i, ω_o)`.
@@ -28,27 +27,30 @@ pub(super) struct BrdfSamples {
     pub contributing: u32,
 }
 
-/// Draws each lane's direction as `Brdf::sample` does from `shading[l]` and the stream `rngs[l]` (two uniforms
-/// for every lane with a shading point), with its density, f_r and ω_i·n.
+/// Draws each lane's direction as `Brdf::sample` does from `shading[l]` and lane l of `rngs` (two uniforms, drawn
+/// in every lane), with its density, f_r and ω_i·n. `(n, wo)` hold the shading points' n and ω_o in lanes, as
+/// `shading` holds them.
 #[inline]
-pub(super) fn sample_brdf_lanes(shading: &[Option<ShadingPoint>; LANES], rngs: &mut [SampleRng; LANES]) -> BrdfSamples {
+pub(super) fn sample_brdf_lanes(
+    shading: &[Option<ShadingPoint>; LANES],
+    (n, wo): (Vec3x8, Vec3x8),
+    rngs: &mut SampleRngLanes,
+) -> BrdfSamples {
+    let (u_x, u_y) = (rngs.uniform(), rngs.uniform());
     let mut drawn = 0u32;
-    let (mut n, mut wo, mut kd, mut ks) =
-        ([Vec3::Z; LANES], [Vec3::Z; LANES], [Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let (mut alpha, mut p_d, mut u_x, mut u_y) = ([0.0; LANES], [1.0; LANES], [0.0; LANES], [0.0; LANES]);
+    let (mut kd, mut ks) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let (mut alpha, mut p_d) = ([0.0; LANES], [1.0; LANES]);
     for l in 0..LANES {
         let Some(sp) = &shading[l] else { continue };
-        let u = rngs[l].uniform_2d();
         let Some(p) = sp.material.diffuse_probability() else { continue };
         drawn |= 1 << l;
-        (n[l], wo[l], kd[l], ks[l]) = (sp.n, sp.wo, sp.material.kd, sp.material.ks);
-        (alpha[l], p_d[l], u_x[l], u_y[l]) = (sp.material.alpha, p, u.x, u.y);
+        (kd[l], ks[l], alpha[l], p_d[l]) = (sp.material.kd, sp.material.ks, sp.material.alpha, p);
     }
     if drawn == 0 {
-        return BrdfSamples::default();
+        let zero = [0.0; LANES];
+        return BrdfSamples { wi: Vec3x8::ZERO, pdf: zero, f: [Vec3::ZERO; LANES], cos: zero, contributing: 0 };
     }
-    let (n, wo) = (Vec3x8::from_lanes(&n), Vec3x8::from_lanes(&wo));
-    let (p_d, u_x, u_y) = (f32x8::new(p_d), f32x8::new(u_x), f32x8::new(u_y));
+    let p_d = f32x8::new(p_d);
     let (zero, one) = (f32x8::ZERO, f32x8::ONE);
 
     // The lecture's Bernoulli lobe choice; u₀ rescaled and reused.
@@ -124,7 +126,6 @@ pub(super) fn sample_brdf_lanes(shading: &[Option<ShadingPoint>; LANES], rngs: &
             contributing |= 1 << l;
         }
     });
-    let wi = std::array::from_fn(|l| wi.lane(l));
     BrdfSamples { wi, pdf, f, cos: cos_out, contributing }
 }
 
@@ -143,6 +144,7 @@ fn frame_to_world(z: Vec3x8, v: Vec3x8) -> Vec3x8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{PixelStreams, SampleRng};
     use crate::render::MisSettings;
     use crate::render::strategy::{Brdf, DirectionStrategy, SampleContext};
     use crate::scene::{Material, load_scene};
@@ -186,19 +188,24 @@ mod tests {
                     error: 0.0,
                 })
             });
-            let mut lanes: [SampleRng; LANES] = std::array::from_fn(|l| SampleRng::new(5, group, l as u64));
-            let mut alone = lanes;
-            let drawn = sample_brdf_lanes(&shading, &mut lanes);
+            let mut lanes = PixelStreams::new(5, group).samples(0);
+            let mut alone: [SampleRng; LANES] = std::array::from_fn(|l| lanes.lane(l));
+            let lane_vectors = |v: fn(&ShadingPoint) -> Vec3| {
+                Vec3x8::from_lanes(&std::array::from_fn(|l| shading[l].as_ref().map_or(Vec3::ZERO, v)))
+            };
+            let (n, wo) = (lane_vectors(|sp| sp.n), lane_vectors(|sp| sp.wo));
+            let drawn = sample_brdf_lanes(&shading, (n, wo), &mut lanes);
+            let next = lanes.uniform();
             for l in 0..LANES {
                 let Some(sp) = &shading[l] else { continue };
                 let s = Brdf.sample(&ctx, sp, &mut alone[l]);
-                assert_eq!(lanes[l].uniform().to_bits(), alone[l].uniform().to_bits(), "streams left alike");
+                assert_eq!(next.as_array_ref()[l].to_bits(), alone[l].uniform().to_bits(), "streams left alike");
                 let Some(s) = s else {
                     assert_eq!(drawn.contributing & (1 << l), 0);
                     continue;
                 };
                 let bits = |v: Vec3| v.to_array().map(f32::to_bits);
-                assert_eq!(bits(drawn.wi[l]), bits(s.wi), "group {group} lane {l}: {:?}", sp.material);
+                assert_eq!(bits(drawn.wi.lane(l)), bits(s.wi), "group {group} lane {l}: {:?}", sp.material);
                 assert_eq!(drawn.pdf[l].to_bits(), s.pdf.to_bits(), "group {group} lane {l}");
                 let cos = sp.n.dot(s.wi);
                 let f = sp.material.eval_brdf(sp.n, sp.wo, s.wi);

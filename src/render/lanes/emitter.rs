@@ -228,12 +228,8 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let mut first = [Vec3::ZERO; LANES];
     let mut shadow_rays = 0;
     let mut shading: [Option<ShadingPoint>; LANES] = [None; LANES];
-    let mut streams = [before.lane(0); LANES];
     for_each_lane(e.hit, |l| {
         let sp = e.shading_point(scene, l);
-        // A sample that drew no point on a light (none picked, or p behind it) used one uniform, else three.
-        let drew_point = e.picked & e.faces & (1 << l) != 0;
-        streams[l] = if drew_point { rngs.lane(l) } else { before.lane(l).after_uniforms(1) };
         let wi = e.wi.lane(l);
         let f = || sp.material.eval_brdf(sp.n, sp.wo, wi);
         let li = || scene.materials[e.light_material[l] as usize].emission;
@@ -250,7 +246,10 @@ pub fn estimate_mis_emitter_brdf_lanes(
         shading[l] = Some(sp);
     });
     // The BRDF directions, each drawn after its lane's light direction.
-    let from_brdf = mis_brdf_technique(&contexts, &Emitter, &shading, &mut streams, rays);
+    // A sample that drew no point on a light (none picked, or p behind it) used one uniform, else three.
+    let mut streams = rngs.with_lanes_after(&before, !(e.picked & e.faces), 1);
+    let near = (e.p, e.n, e.wo, e.p_error);
+    let from_brdf = mis_brdf_technique(&contexts, &Emitter, &shading, near, &mut streams, rays);
     let visible = e.visible(scene, shadow_rays, rays);
     mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }

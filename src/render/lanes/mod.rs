@@ -20,8 +20,8 @@ use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SurfaceError, Vec3x8, for_each_lane};
-use crate::scene::{HitLanes, SKIP_NONE, Scene};
+use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, offset_ray_origins};
+use crate::scene::{Hit, HitLanes, SKIP_NONE, Scene};
 use glam::Vec3;
 use wide::f32x8;
 
@@ -147,6 +147,9 @@ impl ShadowRays {
     /// The lanes whose ray gets through; adds the rays traced to `rays`.
     #[inline(always)]
     fn trace(&self, scene: &Scene, rays: &mut u64) -> u32 {
+        if self.lanes == 0 {
+            return 0; // no lane has a ray (most groups' BRDF directions miss the lights)
+        }
         let [p, n, x, n_x] = self.ends.map(|e| Vec3x8::from_lanes(&e));
         let near = (p, n, f32x8::new(self.p_error));
         visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, rays)
@@ -237,29 +240,51 @@ fn mis_second_technique(
 }
 
 /// [`mis_second_technique`] with BRDF sampling as the second technique, its directions, densities and f_r drawn in
-/// f32x8 ([`brdf::sample_brdf_lanes`]): each lane gets what the generic one gives it, bit for bit.
+/// f32x8 ([`brdf::sample_brdf_lanes`]) from lane l of `rngs` for lane l: each lane gets what the generic one gives
+/// it, bit for bit. `near` holds the shading points' p, n, ω_o and rounding-error bounds in lanes, as `shading`
+/// holds them: the rays leave them as `offset_ray_origin` moves them, all eight at once, and are tested against the
+/// root of the lights' tree in lanes ([`crate::scene::EmitterTree::closest_hits_lanes`]); most miss it, and nothing
+/// is gathered lane by lane for those.
 #[inline(always)]
 fn mis_brdf_technique(
     contexts: &[SampleContext; 2],
     light: &impl Technique,
     shading: &[Option<ShadingPoint>; LANES],
-    rngs: &mut [SampleRng; LANES],
+    (p, n, wo, error): (Vec3x8, Vec3x8, Vec3x8, f32x8),
+    rngs: &mut SampleRngLanes,
     rays: &mut u64,
 ) -> [Vec3; LANES] {
     let scene = contexts[1].scene;
-    let drawn = brdf::sample_brdf_lanes(shading, rngs);
-    let mut traced = TracedRays::default();
-    for_each_lane(drawn.contributing, |l| {
-        let Some(sp) = &shading[l] else { return };
-        let s = DirectionSample { wi: drawn.wi[l], pdf: drawn.pdf[l], target: Target::Trace };
-        traced.add_evaluated(l, sp, s, (drawn.f[l], drawn.cos[l]), rays);
-    });
+    let drawn = brdf::sample_brdf_lanes(shading, (n, wo), rngs);
+    let lanes = drawn.contributing;
+    *rays += lanes.count_ones() as u64;
+    let origins = offset_ray_origins(p, n, error);
+    let found = scene.emitter_tree().closest_hits_lanes(&origins, &drawn.wi, lanes);
     let mut weighted = [Vec3::ZERO; LANES];
-    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
-        let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
+    let mut shadow_rays = ShadowRays::default();
+    for_each_lane(lanes, |l| {
+        let (Some(sp), Some(hit)) = (&shading[l], found[l]) else { return };
+        let s = DirectionSample { wi: drawn.wi.lane(l), pdf: drawn.pdf[l], target: Target::Trace };
+        let Some((value, via)) = lit_along(scene, hit, &s, (drawn.f[l], drawn.cos[l])) else { return };
+        let n_x = scene.triangles[via.triangle as usize].n;
+        shadow_rays.add_from(l, scene, (sp.p, sp.n, sp.error), (via.triangle, via.point, n_x));
         weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
-    }
+    });
+    let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
+    for_each_lane(blocked, |l| weighted[l] = Vec3::ZERO);
     weighted
+}
+
+/// `f_r L_e (ω·n)` along a traced direction `s` whose nearest emitter triangle is `hit` (`f_r` and ω·n given),
+/// and the point it reached, where that triangle emits towards the ray (`None` where L_e = 0): what arrives
+/// unless something lies before it.
+#[inline(always)]
+fn lit_along(scene: &Scene, hit: Hit, s: &DirectionSample, (f, cos): (Vec3, f32)) -> Option<(Vec3, Reached)> {
+    let li = scene.emitted(hit.triangle, -s.wi);
+    if li == Vec3::ZERO {
+        return None;
+    }
+    Some((f * li * cos, Reached { triangle: hit.triangle, point: scene.hit_point(&hit) }))
 }
 
 /// A second-technique sample's share, one direction per technique: `w₂ f_r L_e (ω·n) / p₂` with `value` =
@@ -307,24 +332,11 @@ impl TracedRays {
     #[inline(always)]
     fn add(&mut self, l: usize, sp: &ShadingPoint, s: DirectionSample, rays: &mut u64) -> Result<(), Outcome> {
         let (f, cos) = super::estimator::brdf_and_cos(sp, &s)?;
-        self.add_evaluated(l, sp, s, (f, cos), rays);
-        Ok(())
-    }
-
-    /// [`TracedRays::add`] for a direction whose f_r and ω·n are known (and not zero).
-    #[inline(always)]
-    fn add_evaluated(
-        &mut self,
-        l: usize,
-        sp: &ShadingPoint,
-        s: DirectionSample,
-        (f, cos): (Vec3, f32),
-        rays: &mut u64,
-    ) {
         *rays += 1;
         self.rays[l] = (crate::math::offset_ray_origin(sp.p, sp.n, sp.error), s.wi);
         self.pending[l] = Some(((sp.p, sp.n, sp.error), s, f, cos));
         self.lanes |= 1 << l;
+        Ok(())
     }
 
     /// Per lane: `f_r L_e (ω·n)` where the ray meets a surface that emits towards it, the emitter triangle and point
@@ -340,13 +352,9 @@ impl TracedRays {
         let mut lit = [Err(Outcome::MissedLights); LANES];
         for_each_lane(self.lanes, |l| {
             let (Some((near, s, f, cos)), Some(hit)) = (self.pending[l], found[l]) else { return };
-            let li = scene.emitted(hit.triangle, -s.wi);
-            if li == Vec3::ZERO {
-                return;
-            }
-            let (triangle, point) = (hit.triangle, scene.hit_point(&hit));
-            shadow_rays.add_from(l, scene, near, (triangle, point, scene.triangles[triangle as usize].n));
-            lit[l] = Ok((f * li * cos, super::strategy::Reached { triangle, point }, s));
+            let Some((value, via)) = lit_along(scene, hit, &s, (f, cos)) else { return };
+            shadow_rays.add_from(l, scene, near, (via.triangle, via.point, scene.triangles[via.triangle as usize].n));
+            lit[l] = Ok((value, via, s));
         });
         let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
         for_each_lane(blocked, |l| lit[l] = Err(Outcome::Occluded));

@@ -59,15 +59,22 @@ impl Accel {
     /// takes alone, so its hit is [`Accel::closest_hit`]'s, bit for bit.
     #[inline]
     pub fn closest_hits(&self, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> [Option<Hit>; 8] {
+        let [origins, dirs] = [rays.map(|r| r.0), rays.map(|r| r.1)].map(|v| Vec3x8::from_lanes(&v));
+        self.closest_hits_lanes(&origins, &dirs, active, t_max)
+    }
+
+    /// [`Accel::closest_hits`] for rays given as lanes: ray l is `origins + t·dirs` in lane l.
+    #[inline]
+    pub fn closest_hits_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, active: u32, t_max: f32) -> [Option<Hit>; 8] {
         let Some(root) = self.root.filter(|_| active != 0) else { return [None; 8] };
-        let active = if root.is_leaf() { active } else { self.entering_root(root, rays, active, t_max) };
+        let active = if root.is_leaf() { active } else { self.entering_root(root, origins, dirs, active, t_max) };
         if active == 0 {
             return [None; 8];
         }
         // A walk holds its stack (a kilobyte): the eight are kept per thread and reset in place, where building
         // them per call copied ten kilobytes (a tenth of MIS's time on a small scene).
         WALKS.with_borrow_mut(|walks| {
-            for_each_lane(active, |l| walks[l].reset(root, rays[l].0, rays[l].1, t_max));
+            for_each_lane(active, |l| walks[l].reset(root, origins.lane(l), dirs.lane(l), t_max));
             let mut walking = active;
             while walking != 0 {
                 for_each_lane(walking, |l| {
@@ -146,9 +153,9 @@ impl Accel {
     /// time (as many box tests as one ray's walk makes at the root): a ray that enters none would find nothing
     /// (e.g. most traced directions, in the lights' small tree), and need not walk.
     #[inline(always)]
-    fn entering_root(&self, root: Child, rays: &[(Vec3, Vec3); 8], active: u32, t_max: f32) -> u32 {
+    fn entering_root(&self, root: Child, origins: &Vec3x8, dirs: &Vec3x8, active: u32, t_max: f32) -> u32 {
         let node = &self.nodes[root.first as usize];
-        let lanes = RayLanes::new(&Vec3x8::from_lanes(&rays.map(|r| r.0)), &Vec3x8::from_lanes(&rays.map(|r| r.1)));
+        let lanes = RayLanes::new(origins, dirs);
         let (mut entering, mut children) = (0, node.used());
         while children != 0 && entering != active {
             let k = children.trailing_zeros() as usize;
