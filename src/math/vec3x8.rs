@@ -7,7 +7,7 @@ use glam::Vec3;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 use wide::f32x8;
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct Vec3x8 {
     pub x: f32x8,
     pub y: f32x8,
@@ -15,8 +15,6 @@ pub struct Vec3x8 {
 }
 
 impl Vec3x8 {
-    pub const ZERO: Self = Self { x: f32x8::ZERO, y: f32x8::ZERO, z: f32x8::ZERO };
-
     #[inline(always)]
     pub fn splat(v: Vec3) -> Self {
         Self { x: f32x8::splat(v.x), y: f32x8::splat(v.y), z: f32x8::splat(v.z) }

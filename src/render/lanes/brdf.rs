@@ -14,6 +14,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 use wide::{CmpEq, CmpGt, CmpLt, f32x8};
 
 /// Per lane, a direction drawn from its material's BRDF mixture with what the estimator needs of it.
+#[derive(Default)]
 pub(super) struct BrdfSamples {
     pub wi: Vec3x8,
     /// The mixture's density at ω_i (solid angle).
@@ -47,8 +48,7 @@ pub(super) fn sample_brdf_lanes(
         (kd[l], ks[l], alpha[l], p_d[l]) = (sp.material.kd, sp.material.ks, sp.material.alpha, p);
     }
     if drawn == 0 {
-        let zero = [0.0; LANES];
-        return BrdfSamples { wi: Vec3x8::ZERO, pdf: zero, f: [Vec3::ZERO; LANES], cos: zero, contributing: 0 };
+        return BrdfSamples::default();
     }
     let p_d = f32x8::new(p_d);
     let (zero, one) = (f32x8::ZERO, f32x8::ONE);

@@ -144,6 +144,12 @@ impl ShadowRays {
         self.lanes |= 1 << l;
     }
 
+    /// Lane `l`'s ray from `near` to the point a traced direction reached on an emitter triangle.
+    #[inline(always)]
+    fn add_to_reached(&mut self, l: usize, scene: &Scene, near: Near, via: Reached) {
+        self.add_from(l, scene, near, (via.triangle, via.point, scene.triangles[via.triangle as usize].n));
+    }
+
     /// The lanes whose ray gets through; adds the rays traced to `rays`.
     #[inline(always)]
     fn trace(&self, scene: &Scene, rays: &mut u64) -> u32 {
@@ -266,8 +272,7 @@ fn mis_brdf_technique(
         let (Some(sp), Some(hit)) = (&shading[l], found[l]) else { return };
         let s = DirectionSample { wi: drawn.wi.lane(l), pdf: drawn.pdf[l], target: Target::Trace };
         let Some((value, via)) = lit_along(scene, hit, &s, (drawn.f[l], drawn.cos[l])) else { return };
-        let n_x = scene.triangles[via.triangle as usize].n;
-        shadow_rays.add_from(l, scene, (sp.p, sp.n, sp.error), (via.triangle, via.point, n_x));
+        shadow_rays.add_to_reached(l, scene, (sp.p, sp.n, sp.error), via);
         weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
     });
     let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
@@ -353,7 +358,7 @@ impl TracedRays {
         for_each_lane(self.lanes, |l| {
             let (Some((near, s, f, cos)), Some(hit)) = (self.pending[l], found[l]) else { return };
             let Some((value, via)) = lit_along(scene, hit, &s, (f, cos)) else { return };
-            shadow_rays.add_from(l, scene, near, (via.triangle, via.point, scene.triangles[via.triangle as usize].n));
+            shadow_rays.add_to_reached(l, scene, near, via);
             lit[l] = Ok((value, via, s));
         });
         let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
