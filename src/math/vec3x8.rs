@@ -46,6 +46,13 @@ impl Vec3x8 {
         [Self::new(ax, ay, az), Self::new(bx, by, bz), Self::new(cx, cy, last)]
     }
 
+    /// Lane i as `v[i]`: [`Vec3x8::from_lanes`] undone.
+    #[inline(always)]
+    pub fn to_lanes(&self) -> [Vec3; 8] {
+        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
+        std::array::from_fn(|i| Vec3::new(x[i], y[i], z[i]))
+    }
+
     #[inline(always)]
     pub fn lane(&self, i: usize) -> Vec3 {
         Vec3::new(self.x.as_array_ref()[i], self.y.as_array_ref()[i], self.z.as_array_ref()[i])
@@ -98,6 +105,15 @@ impl Neg for Vec3x8 {
     fn neg(self) -> Self {
         let sign = f32x8::splat(-0.0);
         Self { x: self.x ^ sign, y: self.y ^ sign, z: self.z ^ sign }
+    }
+}
+
+/// Component by component, as `Vec3 * Vec3`.
+impl Mul for Vec3x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Self { x: self.x * o.x, y: self.y * o.y, z: self.z * o.z }
     }
 }
 
@@ -155,6 +171,8 @@ mod tests {
                 assert_eq!(lane(wa - wb), bits(a[i] - b[i]));
                 assert_eq!(lane(-wa), bits(-a[i]));
                 assert_eq!(lane(wa * s), bits(a[i] * d));
+                assert_eq!(lane(wa * wb), bits(a[i] * b[i]));
+                assert_eq!(bits(wa.to_lanes()[i]), bits(a[i]));
                 assert_eq!(lane(wa / s), bits(a[i] / d));
                 assert_eq!(s.as_array_ref()[i].to_bits(), d.to_bits());
                 assert_eq!(wa.length().as_array_ref()[i].to_bits(), a[i].length().to_bits());

@@ -7,9 +7,8 @@
 
 use super::LANES;
 use crate::math::{ONE_MINUS_EPSILON, SampleRngLanes, Vec3x8, for_each_lane, sin_cos_lanes};
-use crate::render::ShadingPoint;
 use crate::sampling::phong_lobe_pdf_from_gap;
-use glam::Vec3;
+use crate::scene::Material;
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 use wide::{CmpEq, CmpGt, CmpLt, f32x8};
 
@@ -20,7 +19,7 @@ pub(super) struct BrdfSamples {
     /// The mixture's density at ω_i (solid angle).
     pub pdf: [f32; LANES],
     /// `f_r(ω_i, ω_o)`.
-    pub f: [Vec3; LANES],
+    pub f: Vec3x8,
     /// `ω_i·n`.
     pub cos: [f32; LANES],
     /// The lanes whose direction can carry light: drawn (a material that is not black), above the surface
@@ -28,30 +27,37 @@ pub(super) struct BrdfSamples {
     pub contributing: u32,
 }
 
-/// Draws each lane's direction as `Brdf::sample` does from `shading[l]` and lane l of `rngs` (two uniforms, drawn
-/// in every lane), with its density, f_r and ω_i·n. `(n, wo)` hold the shading points' n and ω_o in lanes, as
-/// `shading` holds them.
+/// Draws each lane's direction as `Brdf::sample` does at a shading point of material `materials[l]` (none where
+/// the lane has no shading point) from lane l of `rngs` (two uniforms, drawn in every lane), with its density,
+/// f_r and ω_i·n. `(n, wo)` hold the shading points' n and ω_o in lanes.
 #[inline]
 pub(super) fn sample_brdf_lanes(
-    shading: &[Option<ShadingPoint>; LANES],
+    materials: &[Option<&Material>; LANES],
     (n, wo): (Vec3x8, Vec3x8),
     rngs: &mut SampleRngLanes,
 ) -> BrdfSamples {
     let (u_x, u_y) = (rngs.uniform(), rngs.uniform());
-    let mut drawn = 0u32;
-    let (mut kd, mut ks) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    let (mut alpha, mut p_d) = ([0.0; LANES], [1.0; LANES]);
-    for l in 0..LANES {
-        let Some(sp) = &shading[l] else { continue };
-        let Some(p) = sp.material.diffuse_probability() else { continue };
-        drawn |= 1 << l;
-        (kd[l], ks[l], alpha[l], p_d[l]) = (sp.material.kd, sp.material.ks, sp.material.alpha, p);
+    // The materials' k_d, k_s and α as one row each, transposed into one vector per field.
+    let mut rows = [f32x8::ZERO; LANES];
+    for (l, material) in materials.iter().enumerate() {
+        let Some(m) = material else { continue };
+        rows[l] = f32x8::new([m.kd.x, m.kd.y, m.kd.z, m.ks.x, m.ks.y, m.ks.z, m.alpha, 0.0]);
     }
+    let [kd_x, kd_y, kd_z, ks_x, ks_y, ks_z, alpha, _] = f32x8::transpose(rows);
+    let (kd, ks) = (Vec3x8::new(kd_x, kd_y, kd_z), Vec3x8::new(ks_x, ks_y, ks_z));
+    let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+    // `diffuse_probability`: Pr_d = k_d/(k_d + k_s) on the RGB sums, none (nothing drawn) where both are 0.
+    let (d, s) = (kd_x + kd_y + kd_z, ks_x + ks_y + ks_z);
+    // A lane without a material has rows of zeros: none is drawn there.
+    let black = !(d + s).cmp_gt(zero);
+    let drawn = !black.move_mask() as u32 & 0xff;
     if drawn == 0 {
         return BrdfSamples::default();
     }
-    let p_d = f32x8::new(p_d);
-    let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+    let p_d = black.blend(one, d / (d + s));
+    // k_s ≠ 0 as `ks != Vec3::ZERO` has it (−0 is 0, NaN is not).
+    let glossy = !(ks_x.cmp_eq(zero) & ks_y.cmp_eq(zero) & ks_z.cmp_eq(zero));
+    let (alpha_lanes, glossy_lanes) = (alpha.to_array(), glossy.move_mask() as u32);
 
     // The lecture's Bernoulli lobe choice; u₀ rescaled and reused.
     let diffuse = u_x.cmp_lt(p_d);
@@ -77,7 +83,7 @@ pub(super) fn sample_brdf_lanes(
     let u0_lanes = u0.as_array_ref();
     let mut gap = [0.0; LANES];
     for_each_lane(drawn & !diffuse_lanes, |l| {
-        gap[l] = (-(u0_lanes[l].ln() / (alpha[l] + 1.0)).exp_m1()).clamp(0.0, 1.0);
+        gap[l] = (-(u0_lanes[l].ln() / (alpha_lanes[l] + 1.0)).exp_m1()).clamp(0.0, 1.0);
     });
     let (sin_phi, cos_phi) = sin_cos_lanes(f32x8::splat(2.0 * PI) * u_y);
     let gap = f32x8::new(gap);
@@ -94,39 +100,28 @@ pub(super) fn sample_brdf_lanes(
     let cos_o = n.dot(wo);
     let diff = wi - wr;
     let mirror_gap = (f32x8::splat(0.5) * diff.dot(diff)).to_array();
-    let (p_d_lanes, cos_lanes) = (p_d.as_array_ref(), cos.as_array_ref());
+    let p_d_lanes = p_d.as_array_ref();
     let mut lobe = [0.0; LANES];
-    let above = (cos.cmp_gt(zero) & cos_o.cmp_gt(zero)).move_mask() as u32;
+    let above = cos.cmp_gt(zero) & cos_o.cmp_gt(zero);
+    let for_brdf = glossy_lanes & above.move_mask() as u32;
     for_each_lane(drawn, |l| {
-        let for_density = p_d_lanes[l] < 1.0;
-        let for_brdf = ks[l] != Vec3::ZERO && above & (1 << l) != 0;
-        if for_density || for_brdf {
-            lobe[l] = phong_lobe_pdf_from_gap(mirror_gap[l], alpha[l]);
+        if p_d_lanes[l] < 1.0 || for_brdf & (1 << l) != 0 {
+            lobe[l] = phong_lobe_pdf_from_gap(mirror_gap[l], alpha_lanes[l]);
         }
     });
     let lobe = f32x8::new(lobe);
     let pdf = p_d * (cos.max(zero) * f32x8::splat(FRAC_1_PI));
     let pdf = p_d.cmp_lt(one).blend(pdf + (one - p_d) * lobe, pdf);
 
-    // f_r = k_d/π + k_s lobe, 0 with either direction below the surface; `brdf_and_cos`'s checks.
-    let (pdf, cos_out) = (pdf.to_array(), *cos_lanes);
-    let mut f = [Vec3::ZERO; LANES];
-    let mut contributing = 0;
-    for_each_lane(drawn, |l| {
-        if !(cos_out[l] > 0.0 && pdf[l] > 0.0) {
-            return;
-        }
-        if above & (1 << l) != 0 {
-            f[l] = kd[l] * FRAC_1_PI;
-            if ks[l] != Vec3::ZERO {
-                f[l] += ks[l] * lobe.as_array_ref()[l];
-            }
-        }
-        if f[l] != Vec3::ZERO {
-            contributing |= 1 << l;
-        }
-    });
-    BrdfSamples { wi, pdf, f, cos: cos_out, contributing }
+    // f_r = k_d/π + k_s lobe (the lobe added only where k_s ≠ 0), 0 with either direction below the surface;
+    // `brdf_and_cos`'s checks: a lane contributes if ω_i·n > 0, p > 0 and f_r ≠ 0.
+    let diffuse_f = kd * f32x8::splat(FRAC_1_PI);
+    let f = Vec3x8::select(glossy, diffuse_f + ks * lobe, diffuse_f);
+    let kept = above & cos.cmp_gt(zero) & pdf.cmp_gt(zero);
+    let f = Vec3x8::select(kept, f, Vec3x8::default());
+    let nonzero = !(f.x.cmp_eq(zero) & f.y.cmp_eq(zero) & f.z.cmp_eq(zero));
+    let contributing = (kept & nonzero).move_mask() as u32 & drawn;
+    BrdfSamples { wi, pdf: pdf.to_array(), f, cos: cos.to_array(), contributing }
 }
 
 /// `Frame::from_z(z).to_world(v)` lane by lane (Duff et al. 2017), in the scalar code's order.
@@ -145,9 +140,10 @@ fn frame_to_world(z: Vec3x8, v: Vec3x8) -> Vec3x8 {
 mod tests {
     use super::*;
     use crate::math::{PixelStreams, SampleRng};
-    use crate::render::MisSettings;
     use crate::render::strategy::{Brdf, DirectionStrategy, SampleContext};
-    use crate::scene::{Material, load_scene};
+    use crate::render::{MisSettings, ShadingPoint};
+    use crate::scene::load_scene;
+    use glam::Vec3;
 
     /// Every lane's direction, density, f_r and ω_i·n are `Brdf::sample`'s and `eval_brdf`'s, bit for bit, and so
     /// is which lanes contribute: materials diffuse, glossy (α from 0 to 10⁶), with k_s too small to move the
@@ -194,7 +190,7 @@ mod tests {
                 Vec3x8::from_lanes(&std::array::from_fn(|l| shading[l].as_ref().map_or(Vec3::ZERO, v)))
             };
             let (n, wo) = (lane_vectors(|sp| sp.n), lane_vectors(|sp| sp.wo));
-            let drawn = sample_brdf_lanes(&shading, (n, wo), &mut lanes);
+            let drawn = sample_brdf_lanes(&shading.map(|sp| sp.map(|sp| sp.material)), (n, wo), &mut lanes);
             let next = lanes.uniform();
             for l in 0..LANES {
                 let Some(sp) = &shading[l] else { continue };
@@ -212,7 +208,7 @@ mod tests {
                 let contributes = cos > 0.0 && s.pdf > 0.0 && f != Vec3::ZERO;
                 assert_eq!(drawn.contributing & (1 << l) != 0, contributes, "group {group} lane {l}");
                 if contributes {
-                    assert_eq!(bits(drawn.f[l]), bits(f));
+                    assert_eq!(bits(drawn.f.lane(l)), bits(f));
                     assert_eq!(drawn.cos[l].to_bits(), cos.to_bits());
                     contributing += 1;
                     glossy += (sp.material.ks != Vec3::ZERO) as u32;

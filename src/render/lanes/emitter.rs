@@ -13,7 +13,8 @@ use crate::render::strategy::mis::technique_context;
 use crate::render::strategy::{Brdf, Emitter, SampleContext, Technique};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene};
 use glam::Vec3;
-use wide::{CmpGt, CmpLt, f32x8};
+use std::f32::consts::FRAC_1_PI;
+use wide::{CmpEq, CmpGt, CmpLt, f32x8};
 
 /// Emitter sampling's directions for up to eight lanes, before any ray is traced: each lane's shading point, the
 /// light triangle it picked and the point x on it, ω towards x and the density p(ω) = p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|),
@@ -225,31 +226,49 @@ pub fn estimate_mis_emitter_brdf_lanes(
     for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
     // Each lane's light direction's contribution, weighted (if its shadow ray gets through), as `unshadowed`
     // gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
+    // Where the material is diffuse (k_s = 0) in f32x8: f_r = k_d/π where n·ω > 0 (in `ok`) and n·ω_o > 0, and
+    // the BRDF technique's density p_d (ω·n)⁺/π with p_d = k_d/(k_d + 0) = 1, as `eval_brdf` and `pdf_brdf` give
+    // them; lane by lane where k_s ≠ 0.
     let mut first = [Vec3::ZERO; LANES];
-    let mut shadow_rays = 0;
-    let mut shading: [Option<ShadingPoint>; LANES] = [None; LANES];
+    let (mut shadow_rays, mut specular) = (0, 0);
+    let (mut kd, mut li) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let mut materials = [None; LANES];
+    let light = e.ok & e.picked;
     for_each_lane(e.hit, |l| {
-        let sp = e.shading_point(scene, l);
-        let wi = e.wi.lane(l);
-        let f = || sp.material.eval_brdf(sp.n, sp.wo, wi);
-        let li = || scene.materials[e.light_material[l] as usize].emission;
-        if e.ok & e.picked & (1 << l) != 0
-            && let (f, li) = (f(), li())
-            && f != Vec3::ZERO
-            && li != Vec3::ZERO
-        {
-            let value = f * li * e.cos[l];
+        let material = &scene.materials[e.materials[l] as usize];
+        materials[l] = Some(material);
+        if light & (1 << l) == 0 {
+            return;
+        }
+        li[l] = scene.materials[e.light_material[l] as usize].emission;
+        if material.ks == Vec3::ZERO {
+            kd[l] = material.kd;
+            return;
+        }
+        specular |= 1 << l;
+        let (sp, wi) = (e.shading_point(scene, l), e.wi.lane(l));
+        let f = material.eval_brdf(sp.n, sp.wo, wi);
+        if f != Vec3::ZERO && li[l] != Vec3::ZERO {
+            let value = f * li[l] * e.cos[l];
             let w = heuristic.weight(1, e.pdf[l], 1, Brdf.pdf(&contexts[1], &sp, wi, None));
             first[l] = value * (w / (1.0 * e.pdf[l]));
             shadow_rays |= 1 << l;
         }
-        shading[l] = Some(sp);
     });
+    let (f, li) = (Vec3x8::from_lanes(&kd) * f32x8::splat(FRAC_1_PI), Vec3x8::from_lanes(&li));
+    let (cos, pdf) = (f32x8::new(e.cos), f32x8::new(e.pdf));
+    let nonzero = |v: Vec3x8| !(v.x.cmp_eq(f32x8::ZERO) & v.y.cmp_eq(f32x8::ZERO) & v.z.cmp_eq(f32x8::ZERO));
+    let towards = e.n.dot(e.wo).cmp_gt(f32x8::ZERO);
+    let diffuse = (towards & nonzero(f) & nonzero(li)).move_mask() as u32 & light & !specular;
+    let w = heuristic.weight_lanes(pdf, cos.max(f32x8::ZERO) * f32x8::splat(FRAC_1_PI));
+    let weighted = (f * li * cos * (w / (f32x8::ONE * pdf))).to_lanes();
+    for_each_lane(diffuse, |l| first[l] = weighted[l]);
+    shadow_rays |= diffuse;
     // The BRDF directions, each drawn after its lane's light direction.
     // A sample that drew no point on a light (none picked, or p behind it) used one uniform, else three.
     let mut streams = rngs.with_lanes_after(&before, !(e.picked & e.faces), 1);
     let near = (e.p, e.n, e.wo, e.p_error);
-    let from_brdf = mis_brdf_technique(&contexts, &Emitter, &shading, near, &mut streams, rays);
+    let from_brdf = mis_brdf_technique(&contexts, &Emitter, &materials, near, &mut streams, rays);
     let visible = e.visible(scene, shadow_rays, rays);
     mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }

@@ -21,7 +21,7 @@ use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
 use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, offset_ray_origins};
-use crate::scene::{Hit, HitLanes, SKIP_NONE, Scene};
+use crate::scene::{Hit, HitLanes, Material, SKIP_NONE, Scene};
 use glam::Vec3;
 use wide::f32x8;
 
@@ -247,21 +247,22 @@ fn mis_second_technique(
 
 /// [`mis_second_technique`] with BRDF sampling as the second technique, its directions, densities and f_r drawn in
 /// f32x8 ([`brdf::sample_brdf_lanes`]) from lane l of `rngs` for lane l: each lane gets what the generic one gives
-/// it, bit for bit. `near` holds the shading points' p, n, ω_o and rounding-error bounds in lanes, as `shading`
-/// holds them: the rays leave them as `offset_ray_origin` moves them, all eight at once, and are tested against the
-/// root of the lights' tree in lanes ([`crate::scene::EmitterTree::closest_hits_lanes`]); most miss it, and nothing
-/// is gathered lane by lane for those.
+/// it, bit for bit. `near` holds the shading points' p, n, ω_o and rounding-error bounds in lanes, and `materials`
+/// their materials (none where a lane has no shading point): the rays leave them as `offset_ray_origin` moves
+/// them, all eight at once, and are tested against the root of the lights' tree in lanes
+/// ([`crate::scene::EmitterTree::closest_hits_lanes`]); most miss it, and nothing is gathered lane by lane for
+/// those. A lane whose ray finds an emitter has its shading point made up from the lanes.
 #[inline(always)]
 fn mis_brdf_technique(
     contexts: &[SampleContext; 2],
     light: &impl Technique,
-    shading: &[Option<ShadingPoint>; LANES],
+    materials: &[Option<&Material>; LANES],
     (p, n, wo, error): (Vec3x8, Vec3x8, Vec3x8, f32x8),
     rngs: &mut SampleRngLanes,
     rays: &mut u64,
 ) -> [Vec3; LANES] {
     let scene = contexts[1].scene;
-    let drawn = brdf::sample_brdf_lanes(shading, (n, wo), rngs);
+    let drawn = brdf::sample_brdf_lanes(materials, (n, wo), rngs);
     let lanes = drawn.contributing;
     *rays += lanes.count_ones() as u64;
     let origins = offset_ray_origins(p, n, error);
@@ -269,11 +270,12 @@ fn mis_brdf_technique(
     let mut weighted = [Vec3::ZERO; LANES];
     let mut shadow_rays = ShadowRays::default();
     for_each_lane(lanes, |l| {
-        let (Some(sp), Some(hit)) = (&shading[l], found[l]) else { return };
+        let (Some(material), Some(hit)) = (materials[l], found[l]) else { return };
         let s = DirectionSample { wi: drawn.wi.lane(l), pdf: drawn.pdf[l], target: Target::Trace };
-        let Some((value, via)) = lit_along(scene, hit, &s, (drawn.f[l], drawn.cos[l])) else { return };
+        let Some((value, via)) = lit_along(scene, hit, &s, (drawn.f.lane(l), drawn.cos[l])) else { return };
+        let sp = ShadingPoint { p: p.lane(l), n: n.lane(l), wo: wo.lane(l), material, error: error.as_array_ref()[l] };
         shadow_rays.add_to_reached(l, scene, (sp.p, sp.n, sp.error), via);
-        weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
+        weighted[l] = weighted_second(contexts, light, &sp, value, via, &s);
     });
     let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
     for_each_lane(blocked, |l| weighted[l] = Vec3::ZERO);

@@ -19,6 +19,7 @@ use crate::render::sink::{Outcome, SampleRecord, SampleSink};
 use crate::scene::Scene;
 use glam::Vec3;
 use std::sync::Arc;
+use wide::f32x8;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Heuristic {
@@ -50,6 +51,18 @@ impl Heuristic {
             Heuristic::Power => (a * a) / (a * a + b * b),
         };
         if w.is_finite() { w } else { 0.0 }
+    }
+
+    /// [`Heuristic::weight`] with one direction per technique (n_a = n_b = 1) for eight pairs of densities, lane
+    /// by lane, the same value bit for bit.
+    #[inline(always)]
+    pub fn weight_lanes(self, p_a: f32x8, p_b: f32x8) -> f32x8 {
+        let (a, b) = (f32x8::ONE * p_a, f32x8::ONE * p_b);
+        let w = match self {
+            Heuristic::Balance => a / (a + b),
+            Heuristic::Power => (a * a) / (a * a + b * b),
+        };
+        w.is_finite().blend(w, f32x8::ZERO)
     }
 }
 
@@ -239,6 +252,28 @@ mod tests {
         assert!(technique_context(&ctx, 1).state.is_none());
         // No registered technique has state yet, so MIS prepares none.
         assert!(Mis.prepare(&scene, &RenderSettings::default()).is_none());
+    }
+
+    /// Eight weights at once are the weights one at a time, bit for bit: densities from 0 to the largest floats,
+    /// subnormal, infinite and NaN.
+    #[test]
+    fn lanes_weigh_as_one_at_a_time() {
+        let mut rng = SampleRng::new(2, 9, 4);
+        let special = [0.0, -0.0, 1e-45, 1e-30, 1.0, 3e38, f32::MAX, f32::INFINITY, f32::NAN];
+        for round in 0..2000 {
+            let mut density = |k: usize| {
+                if (round + k) % 3 == 0 { special[(round * 7 + k) % special.len()] } else { rng.uniform() * 1e3 }
+            };
+            let p_a: [f32; 8] = std::array::from_fn(&mut density);
+            let p_b: [f32; 8] = std::array::from_fn(|k| density(k + 3));
+            for heuristic in Heuristic::ALL {
+                let lanes = heuristic.weight_lanes(f32x8::new(p_a), f32x8::new(p_b)).to_array();
+                for l in 0..8 {
+                    let alone = heuristic.weight(1, p_a[l], 1, p_b[l]);
+                    assert_eq!(lanes[l].to_bits(), alone.to_bits(), "{p_a:?} {p_b:?} lane {l}");
+                }
+            }
+        }
     }
 
     #[test]
