@@ -62,8 +62,8 @@ impl SampleRng {
     }
 }
 
-/// Eight [`SampleRng`] streams, one per SIMD lane, drawn together: the same numbers as each stream alone, from
-/// loops the compiler vectorises (the 64-bit products become three 32-bit ones per lane under AVX2).
+/// Eight [`SampleRng`] streams, one per SIMD lane, drawn together: the same numbers as each stream alone, in
+/// AVX2 where the build has it ([`avx2`]), else from a loop over the lanes.
 #[derive(Clone, Copy, Debug)]
 pub struct SampleRngLanes {
     state: [u64; 8],
@@ -74,13 +74,18 @@ impl SampleRngLanes {
     /// The next uniform of every stream, lane i from stream i.
     #[inline(always)]
     pub fn uniform(&mut self) -> f32x8 {
-        let mut u = [0.0; 8];
-        for (u, state) in u.iter_mut().zip(&mut self.state) {
-            let old = *state;
-            *state = lcg_step(old, self.increment);
-            *u = to_uniform(xsh_rr(old));
+        #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+        return avx2::uniforms(&mut self.state, self.increment);
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+        {
+            let mut u = [0.0; 8];
+            for (u, state) in u.iter_mut().zip(&mut self.state) {
+                let old = *state;
+                *state = lcg_step(old, self.increment);
+                *u = to_uniform(xsh_rr(old));
+            }
+            f32x8::new(u)
         }
-        f32x8::new(u)
     }
 
     /// These streams, but those of `lanes` (bit i for stream i) as `before`'s after `n` more uniforms: where a
@@ -119,6 +124,52 @@ fn xsh_rr(state: u64) -> u32 {
 #[inline(always)]
 fn to_uniform(bits: u32) -> f32 {
     (bits >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+}
+
+/// PCG32 for eight streams in AVX2 registers (`safe_arch`'s wrappers of the intrinsics the build enables), the same
+/// numbers as [`SampleRng`] bit for bit. Left to the compiler, the LCG's 64-bit products were vectorised but XSH RR
+/// went lane by lane through the general registers (each state moved out, shifted, rotated and moved back).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+mod avx2 {
+    use super::MULTIPLIER;
+    use safe_arch::*;
+    use wide::f32x8;
+
+    /// The next uniform of each of the eight streams `state` (advanced), as `to_uniform(xsh_rr(state))`.
+    #[inline(always)]
+    pub(super) fn uniforms(state: &mut [u64; 8], increment: u64) -> f32x8 {
+        let [lo, hi]: [m256i; 2] = bytemuck::cast(*state);
+        let increment = set_splat_i64_m256i(increment as i64);
+        *state = bytemuck::cast([lcg_step(lo, increment), lcg_step(hi, increment)]);
+        // XSH RR: xsh = ((s >> 18) ^ s) >> 27 and rot = s >> 59 in the low halves, then xsh rotated right by rot
+        // (a left shift by 32 gives 0, so rot = 0 leaves xsh as it is).
+        let xsh = |s| shr_imm_u64_m256i::<27>(bitxor_m256i(shr_imm_u64_m256i::<18>(s), s));
+        let x = low_halves(xsh(lo), xsh(hi));
+        let rot = low_halves(shr_imm_u64_m256i::<59>(lo), shr_imm_u64_m256i::<59>(hi));
+        let left = sub_i32_m256i(set_splat_i32_m256i(32), rot);
+        let bits = bitor_m256i(shr_each_u32_m256i(x, rot), shl_each_u32_m256i(x, left));
+        // The top 24 bits as a uniform in [0, 1): exact in f32.
+        let top = convert_to_m256_from_i32_m256i(shr_imm_u32_m256i::<8>(bits));
+        bytemuck::cast(mul_m256(top, set_splat_m256(1.0 / (1u32 << 24) as f32)))
+    }
+
+    /// `s·M + c mod 2⁶⁴` in four lanes from 32-bit products: `s_lo·M_lo + ((s_hi·M_lo + s_lo·M_hi) << 32)`.
+    #[inline(always)]
+    fn lcg_step(s: m256i, increment: m256i) -> m256i {
+        let m_lo = set_splat_i64_m256i((MULTIPLIER & 0xffff_ffff) as i64);
+        let m_hi = set_splat_i64_m256i((MULTIPLIER >> 32) as i64);
+        let cross =
+            add_i64_m256i(mul_u64_low_bits_m256i(shr_imm_u64_m256i::<32>(s), m_lo), mul_u64_low_bits_m256i(s, m_hi));
+        add_i64_m256i(add_i64_m256i(mul_u64_low_bits_m256i(s, m_lo), shl_imm_u64_m256i::<32>(cross)), increment)
+    }
+
+    /// The low 32 bits of a's four lanes, then of b's, as eight 32-bit lanes in order.
+    #[inline(always)]
+    fn low_halves(a: m256i, b: m256i) -> m256i {
+        // Per 128-bit half: a₀ a₁ b₀ b₁ | a₂ a₃ b₂ b₃; then the 64-bit pairs reordered.
+        let mixed = shuffle_m256::<0b10_00_10_00>(cast_to_m256_from_m256i(a), cast_to_m256_from_m256i(b));
+        shuffle_ai_i64_all_m256i::<0b11_01_10_00>(cast_to_m256i_from_m256(mixed))
+    }
 }
 
 /// The part of every sample stream's key that depends only on (seed, pixel): hashed once per pixel, so each
@@ -233,6 +284,27 @@ mod tests {
             assert!((mean - 0.5).abs() < 4.6e-3, "{mean}");
         }
         assert_eq!(pixel.sample(7).uniform(), SampleRng::new(1, 12_345, 7).uniform());
+    }
+
+    /// Eight streams drawn together give each stream's numbers alone, bit for bit, over many states: every
+    /// rotation XSH RR can apply (0 to 31) is met in every lane.
+    #[test]
+    fn eight_streams_together_are_each_stream_alone() {
+        let mut rotations = [[0u32; 32]; 8];
+        for pixel in 0..2000 {
+            let mut lanes = PixelStreams::new(3, pixel).samples(pixel * 8);
+            let mut alone: [SampleRng; 8] = std::array::from_fn(|i| lanes.lane(i));
+            for _ in 0..8 {
+                for (i, stream) in alone.iter().enumerate() {
+                    rotations[i][(stream.state >> 59) as usize] += 1;
+                }
+                let together = lanes.uniform().to_array();
+                for (i, stream) in alone.iter_mut().enumerate() {
+                    assert_eq!(together[i].to_bits(), stream.uniform().to_bits(), "pixel {pixel}, lane {i}");
+                }
+            }
+        }
+        assert!(rotations.iter().flatten().all(|&n| n > 100), "{rotations:?}");
     }
 
     /// The streams are `rand_pcg::Pcg32`'s, number for number: alone, eight at a time, and alone again after
