@@ -88,13 +88,17 @@ impl EmitterLanes {
         // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
         // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
         // The records are read once every lane has picked, so that their loads wait on the alias table together.
+        // A selection that does not depend on the point picks in every lane (each draws its uniform): all eight
+        // records are read, without a loop over the lanes that hit; what the others compute is never read.
         let none = EmitterTriangle::NONE.rows();
         let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
         let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
         let mut picked = 0;
         if let Some(records) = emitters.pick_fixed_lanes(u_light) {
-            for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
+            for (l, record) in records.iter().enumerate() {
+                ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
+            }
             picked = hit;
         } else {
             for_each_lane(hit, |l| {
@@ -222,14 +226,12 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let heuristic = ctx.mis.heuristic;
     let before = *rngs;
     let e = EmitterLanes::draw(scene, emitters, dirs, hits, rngs);
-    let mut emitted = [Vec3::ZERO; LANES];
-    for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
-    // Each lane's light direction's contribution, weighted (if its shadow ray gets through), as `unshadowed`
-    // gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
+    // Each lane's L_e towards the camera, and its light direction's contribution, weighted (if its shadow ray
+    // gets through), as `unshadowed` gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
     // Where the material is diffuse (k_s = 0) in f32x8: f_r = k_d/π where n·ω > 0 (in `ok`) and n·ω_o > 0, and
     // the BRDF technique's density p_d (ω·n)⁺/π with p_d = k_d/(k_d + 0) = 1, as `eval_brdf` and `pdf_brdf` give
     // them; lane by lane where k_s ≠ 0.
-    let mut first = [Vec3::ZERO; LANES];
+    let (mut emitted, mut first) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let (mut shadow_rays, mut specular) = (0, 0);
     let (mut kd, mut li) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     let mut materials = [None; LANES];
@@ -237,6 +239,9 @@ pub fn estimate_mis_emitter_brdf_lanes(
     for_each_lane(e.hit, |l| {
         let material = &scene.materials[e.materials[l] as usize];
         materials[l] = Some(material);
+        if e.front & (1 << l) != 0 {
+            emitted[l] = material.emission;
+        }
         if light & (1 << l) == 0 {
             return;
         }
