@@ -1,9 +1,10 @@
 //! Phong BRDF sampling ([`crate::render::strategy::Brdf`]) for up to eight shading points at once: the lobe
-//! choice, the cosine-weighted and the cos^α samples, the frames around n and ω_r, the mixture's density
-//! `p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α` and f_r run in f32x8, the sample's angle's sin and cos
-//! too (`crate::math::sin_cos_lanes`, the scalar samplers' own arithmetic). The other transcendental functions
-//! (the lobe's ln and expm1, the density's `cos^α`) are the scalar code's own calls, lane by lane, and every other operation is the scalar code's, in its order and without fused multiply-adds
-//! (as [`Vec3x8`]'s): each lane gets what `Brdf::sample` and `eval_brdf` give it, bit for bit.
+//! probability Pr_d from the lanes' materials, the lobe choice, the cosine-weighted and the cos^α samples, the
+//! frames around n and ω_r, the mixture's density `p(ω) = Pr_d (ω·n)/π + (1−Pr_d) (α+1)/(2π) (ω·ω_r)^α` and f_r
+//! run in f32x8, the sample's angle's sin and cos too (`crate::math::sin_cos_lanes`, the scalar samplers' own
+//! arithmetic). The other transcendental functions (the lobe's ln and expm1, the density's `cos^α`) are the
+//! scalar code's own calls, lane by lane, and every other operation is the scalar code's, in its order and without
+//! fused multiply-adds (as [`Vec3x8`]'s): each lane gets what `Brdf::sample` and `eval_brdf` give it, bit for bit.
 
 use super::LANES;
 use crate::math::{ONE_MINUS_EPSILON, SampleRngLanes, Vec3x8, for_each_lane, sin_cos_lanes};

@@ -89,7 +89,8 @@ impl EmitterLanes {
         // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
         // The records are read once every lane has picked, so that their loads wait on the alias table together.
         // A selection that does not depend on the point picks in every lane (each draws its uniform): all eight
-        // records are read, without a loop over the lanes that hit; what the others compute is never read.
+        // records are read, without a loop over the lanes that hit; the others' values are masked out (`picked`
+        // is `hit`), and no shadow ray is traced for them.
         let none = EmitterTriangle::NONE.rows();
         let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
