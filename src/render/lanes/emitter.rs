@@ -88,18 +88,13 @@ impl EmitterLanes {
         // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
         // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
         // The records are read once every lane has picked, so that their loads wait on the alias table together.
-        // A selection that does not depend on the point picks in every lane (each draws its uniform): all eight
-        // records are read, without a loop over the lanes that hit; the others' values are masked out (`picked`
-        // is `hit`), and no shadow ray is traced for them.
         let none = EmitterTriangle::NONE.rows();
         let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
         let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
         let mut picked = 0;
         if let Some(records) = emitters.pick_fixed_lanes(u_light) {
-            for (l, record) in records.iter().enumerate() {
-                ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
-            }
+            for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
             picked = hit;
         } else {
             for_each_lane(hit, |l| {
