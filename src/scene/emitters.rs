@@ -151,14 +151,23 @@ impl EmitterSampler {
         &self.triangles
     }
 
-    /// What [`EmitterSampler::pick`] picks for eight uniforms (record i for `u[i]`), as light sampling reads it,
-    /// for the selections that do not depend on the shading point (`None` for [`LightSelection::Contribution`]).
+    /// What [`EmitterSampler::pick`] picks for eight uniforms (slot and record i for `u[i]`), as light sampling
+    /// reads it, for the selections that do not depend on the shading point (`None` for
+    /// [`LightSelection::Contribution`]).
     #[inline(always)]
-    pub fn pick_fixed_lanes(&self, u: [f32; 8]) -> Option<[&EmitterTriangle; 8]> {
+    pub fn pick_fixed_lanes(&self, u: [f32; 8]) -> Option<([usize; 8], [&EmitterTriangle; 8])> {
         if self.records.is_empty() {
             return None;
         }
-        Some(self.distribution.sample_indices(u).map(|i| &self.records[i]))
+        let slots = self.distribution.sample_indices(u);
+        Some((slots, slots.map(|i| &self.records[i])))
+    }
+
+    /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
+    /// emit.
+    #[inline]
+    pub fn slot(&self, triangle: u32) -> u32 {
+        self.slot_of.get(triangle as usize).copied().unwrap_or(u32::MAX)
     }
 
     /// Picks an emitter triangle Δ for the shading point p with one uniform; returns it and p_Δ. `None` where
@@ -236,12 +245,13 @@ mod tests {
             let sampler = EmitterSampler::new(&scene, selection).unwrap();
             for i in (0..10_000).step_by(8) {
                 let u = std::array::from_fn(|l| (i + l) as f32 / 10_000.0);
-                let Some(records) = sampler.pick_fixed_lanes(u) else {
+                let Some((slots, records)) = sampler.pick_fixed_lanes(u) else {
                     assert_eq!(selection, LightSelection::Contribution);
                     continue;
                 };
-                for (e, u) in records.iter().zip(u) {
+                for ((e, u), slot) in records.iter().zip(u).zip(slots) {
                     let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
+                    assert_eq!((scene.emitters[slot], sampler.slot(t)), (t, slot as u32));
                     let tri = &scene.triangles[t as usize];
                     let record = (e.v, e.n, e.area, e.p_delta, e.material);
                     assert_eq!(record, (tri.v, tri.n, tri.area, p_delta, tri.material));

@@ -4,6 +4,7 @@
 mod accel;
 mod bundled;
 mod camera;
+mod clear_lights;
 mod convex;
 mod emitter_tree;
 mod emitters;
@@ -16,7 +17,9 @@ mod obj;
 
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
-pub use accel::{Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, VectorPath, has_avx512, vector_path};
+pub use accel::{
+    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, Shaft, VectorPath, has_avx512, vector_path,
+};
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};

@@ -44,6 +44,9 @@ struct EmitterLanes {
     wi: Vec3x8,
     pdf: [f32; LANES],
     cos: [f32; LANES],
+    /// The lanes whose picked light is one of the pixel's clear lights (`Scene::clear_lights`): their shadow
+    /// rays get through, found without tracing them.
+    clear: u32,
     /// The lanes whose direction is a sample that can contribute: on the emitting side, at a positive finite
     /// density, above the surface.
     ok: u32,
@@ -51,11 +54,11 @@ struct EmitterLanes {
 
 impl EmitterLanes {
     /// Draws each lane's direction: the light's uniform, then the point's two, from lane l of `rngs` (every lane
-    /// draws all three, used or not).
+    /// draws all three, used or not). `clear_lights` has bit s set for the pixel's clear emitter slots s.
     #[inline(always)]
     fn draw(
         scene: &Scene,
-        emitters: &EmitterSampler,
+        (emitters, clear_lights): (&EmitterSampler, u32),
         dirs: &Vec3x8,
         hits: &HitLanes,
         rngs: &mut SampleRngLanes,
@@ -93,15 +96,21 @@ impl EmitterLanes {
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
         let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
         let mut picked = 0;
-        if let Some(records) = emitters.pick_fixed_lanes(u_light) {
+        // Bit l set where lane l's slot is clear (slots past 63 never are: `clear_lights` has 32 bits).
+        let (mut clear, is_clear) = (0, |slot: usize| (clear_lights as u64 >> slot.min(63)) & 1);
+        if let Some((slots, records)) = emitters.pick_fixed_lanes(u_light) {
             for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
             picked = hit;
+            if clear_lights != 0 {
+                for_each_lane(hit, |l| clear |= (is_clear(slots[l]) as u32) << l);
+            }
         } else {
             for_each_lane(hit, |l| {
                 if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
                     let record = EmitterTriangle::of(scene, t, p_delta);
                     ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
                     picked |= 1 << l;
+                    clear |= (is_clear(emitters.slot(t) as usize) as u32) << l;
                 }
             });
         }
@@ -148,6 +157,7 @@ impl EmitterLanes {
             wi,
             pdf: pdf.to_array(),
             cos: cos.to_array(),
+            clear,
             ok: ok.move_mask() as u32,
         }
     }
@@ -161,11 +171,14 @@ impl EmitterLanes {
         ShadingPoint { p, n, wo, material, error }
     }
 
-    /// The lanes of `active` whose shadow ray gets through; adds the rays traced to `rays`.
+    /// The lanes of `active` whose shadow ray gets through; adds the shadow rays to `rays` (those to a clear
+    /// light are answered without being traced).
     #[inline(always)]
     fn visible(&self, scene: &Scene, active: u32, rays: &mut u64) -> u32 {
         let (near, far) = ((self.p, self.n, self.p_error), (self.x, self.ln));
-        visible_lanes(scene, near, far, (&self.light_error, self.light_group), active, rays)
+        let clear = active & self.clear;
+        *rays += clear.count_ones() as u64;
+        clear | visible_lanes(scene, near, far, (&self.light_error, self.light_group), active & !clear, rays)
     }
 }
 
@@ -175,13 +188,13 @@ impl EmitterLanes {
 #[inline]
 pub fn estimate_emitter_lanes(
     scene: &Scene,
-    emitters: &EmitterSampler,
+    lights: (&EmitterSampler, u32),
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    let e = EmitterLanes::draw(scene, emitters, dirs, hits, rngs);
+    let e = EmitterLanes::draw(scene, lights, dirs, hits, rngs);
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
@@ -211,7 +224,7 @@ pub fn estimate_emitter_lanes(
 #[inline(never)]
 pub fn estimate_mis_emitter_brdf_lanes(
     ctx: &SampleContext,
-    emitters: &EmitterSampler,
+    lights: (&EmitterSampler, u32),
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
@@ -221,7 +234,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
     let heuristic = ctx.mis.heuristic;
     let before = *rngs;
-    let e = EmitterLanes::draw(scene, emitters, dirs, hits, rngs);
+    let e = EmitterLanes::draw(scene, lights, dirs, hits, rngs);
     // Each lane's L_e towards the camera, and its light direction's contribution, weighted (if its shadow ray
     // gets through), as `unshadowed` gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
     // Where the material is diffuse (k_s = 0) in f32x8: f_r = k_d/π where n·ω > 0 (in `ok`) and n·ω_o > 0, and
@@ -308,7 +321,7 @@ mod tests {
                     let (mut simd_rays, mut lane_rays) = (0, 0);
                     let mut lane_rngs = std::array::from_fn(|l| rngs.lane(l));
                     let simd =
-                        estimate_mis_emitter_brdf_lanes(&ctx, &emitters, &dirs, &hits, &mut rngs, &mut simd_rays);
+                        estimate_mis_emitter_brdf_lanes(&ctx, (&emitters, 0), &dirs, &hits, &mut rngs, &mut simd_rays);
                     let by_lane =
                         estimate_mis_lanes(&ctx, (&Emitter, &Brdf), &dirs, &hits, &mut lane_rngs, &mut lane_rays);
                     for l in 0..n {

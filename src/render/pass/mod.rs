@@ -258,14 +258,15 @@ impl Renderer {
                     let mut cones = (self.settings.footprint == Footprint::Jittered)
                         .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
                     for (x, acc) in row.iter_mut().enumerate() {
-                        let cone = cones.as_mut().and_then(|c| c.next()).flatten();
+                        let (cone, clear_lights) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, 0));
                         let streams = streams(x);
                         for group in (first..first + count).step_by(LANES) {
                             let samples = group..(group + LANES as u32).min(first + count);
                             let n = samples.len();
                             let pixel = (x as u32, y as u32);
                             let learned = learned.as_deref_mut();
-                            let values = self.sample_lanes(pixel, &streams, samples, cone.as_ref(), &mut rays, learned);
+                            let cone = (cone.as_ref(), clear_lights);
+                            let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
                             values[..n].iter().for_each(|&v| add(acc, v));
                         }
                     }
@@ -329,14 +330,15 @@ impl Renderer {
 
     /// Samples `samples` (at most eight) of pixel (x, y), one per lane; lane l gets what [`Self::camera_ray`] and
     /// [`Self::shade`] give sample `samples.start + l`, bit for bit. `cone`, when given, holds every triangle the
-    /// pixel's camera rays can hit.
+    /// pixel's camera rays can hit; `clear_lights` has bit s set for the emitter slots s that every shadow ray
+    /// from the pixel reaches (`Scene::clear_lights`).
     #[inline]
     fn sample_lanes(
         &self,
         (x, y): (u32, u32),
         streams: &PixelStreams,
         samples: Range<u32>,
-        cone: Option<&ConeCandidates>,
+        (cone, clear_lights): (Option<&ConeCandidates>, u32),
         rays: &mut u64,
         mut learned: Option<&mut Vec<GuideRecord>>,
     ) -> [Vec3; LANES] {
@@ -364,7 +366,7 @@ impl Renderer {
         let strategy = self.settings.strategy;
         match (strategy, &self.emitters) {
             (Strategy::Emitter, Some(emitters)) => {
-                estimate_emitter_lanes(&self.scene, emitters, &dirs, &hits, &mut rngs, rays)
+                estimate_emitter_lanes(&self.scene, (emitters, clear_lights), &dirs, &hits, &mut rngs, rays)
             }
             (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
@@ -407,7 +409,8 @@ impl Renderer {
                     && self.settings.mis.samples == [1, 1]
                     && self.settings.mis.techniques == [Strategy::Emitter, Strategy::Brdf] =>
             {
-                estimate_mis_emitter_brdf_lanes(&self.context(), emitters, &dirs, &hits, &mut rngs, rays)
+                let lights = (emitters, clear_lights);
+                estimate_mis_emitter_brdf_lanes(&self.context(), lights, &dirs, &hits, &mut rngs, rays)
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)

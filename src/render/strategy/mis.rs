@@ -262,7 +262,11 @@ mod tests {
         let special = [0.0, -0.0, 1e-45, 1e-30, 1.0, 3e38, f32::MAX, f32::INFINITY, f32::NAN];
         for round in 0..2000 {
             let mut density = |k: usize| {
-                if (round + k) % 3 == 0 { special[(round * 7 + k) % special.len()] } else { rng.uniform() * 1e3 }
+                if (round + k).is_multiple_of(3) {
+                    special[(round * 7 + k) % special.len()]
+                } else {
+                    rng.uniform() * 1e3
+                }
             };
             let p_a: [f32; 8] = std::array::from_fn(&mut density);
             let p_b: [f32; 8] = std::array::from_fn(|k| density(k + 3));

@@ -14,6 +14,7 @@ mod node;
 mod packet;
 mod ray;
 mod shadow_bundle;
+mod shaft;
 mod traverse;
 mod vectors;
 
@@ -21,6 +22,7 @@ pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;
+pub use shaft::Shaft;
 pub use vectors::{VectorPath, has_avx512, vector_path};
 use wide::f32x8;
 

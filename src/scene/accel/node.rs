@@ -106,7 +106,6 @@ impl Node8 {
     }
 
     /// min x, min y, min z, max x, max y, max z of the children's boxes, child k in lane k.
-    #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
     #[inline(always)]
     pub fn bounds(&self) -> &[f32x8; 6] {
         &self.bounds

@@ -172,7 +172,6 @@ impl TrianglePacket {
     }
 
     /// v₀, e₁ and e₂ of the eight lanes.
-    #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
     #[inline(always)]
     pub fn edges(&self) -> (&[f32x8; 3], &[f32x8; 3], &[f32x8; 3]) {
         (&self.v0, &self.e1, &self.e2)
