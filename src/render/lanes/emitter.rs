@@ -12,9 +12,10 @@ use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
 use crate::render::strategy::{Brdf, Emitter, SampleContext, Technique};
 use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene};
+use bytemuck::cast;
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
-use wide::{CmpEq, CmpGt, CmpLt, f32x8};
+use wide::{CmpEq, CmpGt, CmpLt, f32x8, i32x8};
 
 /// Emitter sampling's directions for up to eight lanes, before any ray is traced: each lane's shading point, the
 /// light triangle it picked and the point x on it, ω towards x and the density p(ω) = p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|),
@@ -69,17 +70,32 @@ impl EmitterLanes {
         let hit = hits.mask;
         // The shading points: x = v₀ + u (v₁ − v₀) + v (v₂ − v₀), with the normal turned towards ω_o = −dir. Each
         // lane's triangle as two rows of eight, transposed into one vector per component; (u, v) come as vectors.
-        let mut rows = [[f32x8::ZERO; LANES]; 2];
+        // Where every lane that hit met one triangle (most groups: a pixel inside a face), its values are
+        // broadcast instead; a lane that missed holds zeros either way.
         let mut materials = [0; LANES];
-        for_each_lane(hit, |l| {
-            let tri = &scene.triangles[hits.triangle[l] as usize];
-            let (c, n) = (tri.v[2], tri.n);
-            rows[0][l] = Vec3x8::triangle_row(tri.v);
-            rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, tri.error.at_point, 0.0, 0.0, 0.0]);
-            materials[l] = tri.material;
-        });
-        let [cz, nx, ny, nz, p_error, _, _, _] = f32x8::transpose(rows[1]);
-        let [a, b, c] = Vec3x8::triangles(rows[0], cz);
+        let first = hits.triangle[(hit.trailing_zeros() & 7) as usize];
+        let same = hits.triangle.iter().enumerate().fold(0, |m, (l, &t)| m | ((t == first) as u32) << l);
+        let ([a, b, c], [nx, ny, nz], p_error) = if hit != 0 && same & hit == hit {
+            let tri = &scene.triangles[first as usize];
+            for_each_lane(hit, |l| materials[l] = tri.material);
+            // All bits set in the lanes that hit (a comparison's true).
+            let bits = i32x8::new(std::array::from_fn(|l| 1 << l));
+            let on: f32x8 = cast((i32x8::splat(hit as i32) & bits).cmp_eq(bits));
+            let vertex = |v: Vec3| Vec3x8::select(on, Vec3x8::splat(v), Vec3x8::splat(Vec3::ZERO));
+            let n = vertex(tri.n);
+            (tri.v.map(vertex), [n.x, n.y, n.z], on.blend(f32x8::splat(tri.error.at_point), f32x8::ZERO))
+        } else {
+            let mut rows = [[f32x8::ZERO; LANES]; 2];
+            for_each_lane(hit, |l| {
+                let tri = &scene.triangles[hits.triangle[l] as usize];
+                let (c, n) = (tri.v[2], tri.n);
+                rows[0][l] = Vec3x8::triangle_row(tri.v);
+                rows[1][l] = f32x8::new([c.z, n.x, n.y, n.z, tri.error.at_point, 0.0, 0.0, 0.0]);
+                materials[l] = tri.material;
+            });
+            let [cz, nx, ny, nz, p_error, _, _, _] = f32x8::transpose(rows[1]);
+            (Vec3x8::triangles(rows[0], cz), [nx, ny, nz], p_error)
+        };
         let (u, v) = (hits.u, hits.v);
         let p = a + (b - a) * u + (c - a) * v;
         let wo = -*dirs;
