@@ -38,13 +38,24 @@ pub(super) fn sample_brdf_lanes(
     rngs: &mut SampleRngLanes,
 ) -> BrdfSamples {
     let (u_x, u_y) = (rngs.uniform(), rngs.uniform());
-    // The materials' k_d, k_s and α as one row each, transposed into one vector per field.
-    let mut rows = [f32x8::ZERO; LANES];
-    for (l, material) in materials.iter().enumerate() {
-        let Some(m) = material else { continue };
-        rows[l] = f32x8::new([m.kd.x, m.kd.y, m.kd.z, m.ks.x, m.ks.y, m.ks.z, m.alpha, 0.0]);
-    }
-    let [kd_x, kd_y, kd_z, ks_x, ks_y, ks_z, alpha, _] = f32x8::transpose(rows);
+    // The materials' k_d, k_s and α as one row each, transposed into one vector per field; where every lane
+    // with a material has the same one (most groups), broadcast. A lane without one holds zeros either way.
+    let first = materials.iter().flatten().next();
+    let same = first.is_some_and(|f| materials.iter().flatten().all(|m| std::ptr::eq(*m, *f)));
+    let [kd_x, kd_y, kd_z, ks_x, ks_y, ks_z, alpha, _] = match first {
+        Some(m) if same => {
+            let on = f32x8::new(materials.map(|m| if m.is_some() { f32::from_bits(u32::MAX) } else { 0.0 }));
+            [m.kd.x, m.kd.y, m.kd.z, m.ks.x, m.ks.y, m.ks.z, m.alpha, 0.0].map(|v| on & f32x8::splat(v))
+        }
+        _ => {
+            let mut rows = [f32x8::ZERO; LANES];
+            for (l, material) in materials.iter().enumerate() {
+                let Some(m) = material else { continue };
+                rows[l] = f32x8::new([m.kd.x, m.kd.y, m.kd.z, m.ks.x, m.ks.y, m.ks.z, m.alpha, 0.0]);
+            }
+            f32x8::transpose(rows)
+        }
+    };
     let (kd, ks) = (Vec3x8::new(kd_x, kd_y, kd_z), Vec3x8::new(ks_x, ks_y, ks_z));
     let (zero, one) = (f32x8::ZERO, f32x8::ONE);
     // `diffuse_probability`: Pr_d = k_d/(k_d + k_s) on the RGB sums, none (nothing drawn) where both are 0.
