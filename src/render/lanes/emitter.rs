@@ -215,17 +215,47 @@ pub fn estimate_emitter_lanes(
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
     let mut shadow_rays = 0;
-    for_each_lane(e.ok & e.picked, |l| {
-        let material = &scene.materials[e.materials[l] as usize];
-        let wi = e.wi.lane(l);
-        let f = material.eval_brdf(e.n.lane(l), e.wo.lane(l), wi);
-        // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`.
-        let li = scene.materials[e.light_material[l] as usize].emission;
-        if f != Vec3::ZERO && li != Vec3::ZERO {
-            reflected[l] = f * li * e.cos[l] / e.pdf[l];
-            shadow_rays |= 1 << l;
+    let light = e.ok & e.picked;
+    // Where every such lane shades one diffuse material (most groups), f_r = k_d/π wherever n·ω_o > 0 (n·ω > 0
+    // is in `ok`), as `eval_brdf` gives it, and the value is computed in f32x8; lane by lane elsewhere.
+    let m = e.materials[(light.trailing_zeros() & 7) as usize];
+    let alike = (0..LANES).fold(0, |a, l| a | ((e.materials[l] == m) as u32) << l);
+    // Lane 0's material where no lane picked a light: a scene with emitters has materials.
+    let material = &scene.materials[m as usize];
+    if light != 0 && alike & light == light && material.ks == Vec3::ZERO {
+        let f = material.kd * FRAC_1_PI;
+        // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`. One
+        // light material (a scene with one light) is broadcast, several gathered.
+        let emission = |l: usize| scene.materials[e.light_material[l] as usize].emission;
+        let lm = e.light_material[(light.trailing_zeros() & 7) as usize];
+        let one_light = (0..LANES).all(|l| light & (1 << l) == 0 || e.light_material[l] == lm);
+        let (li, lit) = if one_light {
+            let li = scene.materials[lm as usize].emission;
+            (Vec3x8::splat(li), if li != Vec3::ZERO { light } else { 0 })
+        } else {
+            let (mut li, mut lit) = ([Vec3::ZERO; LANES], 0);
+            for_each_lane(light, |l| {
+                li[l] = emission(l);
+                lit |= ((li[l] != Vec3::ZERO) as u32) << l;
+            });
+            (Vec3x8::from_lanes(&li), lit)
+        };
+        if f != Vec3::ZERO {
+            shadow_rays = lit & e.n.dot(e.wo).cmp_gt(f32x8::ZERO).move_mask() as u32;
+            reflected = (Vec3x8::splat(f) * li * f32x8::new(e.cos) / f32x8::new(e.pdf)).to_lanes();
         }
-    });
+    } else {
+        for_each_lane(light, |l| {
+            let material = &scene.materials[e.materials[l] as usize];
+            let wi = e.wi.lane(l);
+            let f = material.eval_brdf(e.n.lane(l), e.wo.lane(l), wi);
+            let li = scene.materials[e.light_material[l] as usize].emission;
+            if f != Vec3::ZERO && li != Vec3::ZERO {
+                reflected[l] = f * li * e.cos[l] / e.pdf[l];
+                shadow_rays |= 1 << l;
+            }
+        });
+    }
     let visible = e.visible(scene, shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
