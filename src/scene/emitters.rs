@@ -52,7 +52,14 @@ pub struct EmitterSampler {
     /// What light sampling reads of each slot's triangle, with its p_Δ, for the selections that do not depend on
     /// the shading point (empty for the others).
     records: Vec<EmitterTriangle>,
+    /// For at most [`FIELD_TABLE_SLOTS`] records: field k of every record's rows ([`EmitterTriangle::rows`]) in
+    /// one vector, record s in lane s, [`EmitterTriangle::NONE`]'s in the lanes after them: eight picks read
+    /// each field with one permute instead of sixteen loads and two transposes.
+    fields: Option<[f32x8; 16]>,
 }
+
+/// The most records [`EmitterSampler::picked_fields`] holds in vectors (lane 7 stands for no light).
+const FIELD_TABLE_SLOTS: usize = 7;
 
 /// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
 /// holds what sampling reads, the second the offset bounds the shadow ray reads later): picking one costs one
@@ -139,7 +146,11 @@ impl EmitterSampler {
             let record = |(slot, &t): (usize, &u32)| EmitterTriangle::of(scene, t, distribution.pmf(slot));
             scene.emitters.iter().enumerate().map(record).collect()
         };
-        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records })
+        let fields = (!records.is_empty() && records.len() <= FIELD_TABLE_SLOTS).then(|| {
+            let rows = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).rows();
+            std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| rows(s)[k / 8].as_array_ref()[k % 8])))
+        });
+        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, fields })
     }
 
     pub fn selection(&self) -> LightSelection {
@@ -161,6 +172,16 @@ impl EmitterSampler {
         }
         let slots = self.distribution.sample_indices(u);
         Some((slots, slots.map(|i| &self.records[i])))
+    }
+
+    /// Field k ([`EmitterTriangle::rows`]' k-th value) of the record picked in each lane: slot `slots[l]` in the
+    /// lanes of `lanes` (bit l for lane l), [`EmitterTriangle::NONE`]'s elsewhere. `None` where the records are
+    /// not held in vectors (more than seven, or a selection that depends on the shading point).
+    #[inline(always)]
+    pub fn picked_fields(&self, slots: [usize; 8], lanes: u32) -> Option<[f32x8; 16]> {
+        let fields = self.fields.as_ref()?;
+        let index: [i32; 8] = std::array::from_fn(|l| if lanes & (1 << l) != 0 { slots[l] as i32 } else { 7 });
+        Some(fields.map(|field| lane_lookup(field, index)))
     }
 
     /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
@@ -233,22 +254,49 @@ fn contribution(scene: &Scene, t: u32, p: Vec3) -> f64 {
     if solid_angle.is_finite() { solid_angle * l } else { std::f64::consts::TAU * l }
 }
 
+/// Lane `index[l]` of `table` in lane l (each index below 8): one `vpermps` where the build has AVX2.
+#[inline(always)]
+fn lane_lookup(table: f32x8, index: [i32; 8]) -> f32x8 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    {
+        let index: safe_arch::m256i = bytemuck::cast(index);
+        bytemuck::cast(safe_arch::shuffle_av_i32_all_m256(bytemuck::cast(table), index))
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    {
+        f32x8::new(index.map(|i| table.as_array_ref()[i as usize]))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scene::load_scene;
 
+    /// The records (and, for a scene of few emitter triangles, their fields in vectors) hold what `pick` picks.
     #[test]
     fn records_hold_what_pick_picks() {
-        let scene = load_scene("veach-mis").unwrap();
-        for selection in LightSelection::ALL {
+        for (name, selection) in
+            ["veach-mis", "cornell-box"].into_iter().flat_map(|n| LightSelection::ALL.map(|s| (n, s)))
+        {
+            let scene = load_scene(name).unwrap();
             let sampler = EmitterSampler::new(&scene, selection).unwrap();
+            let fixed = selection != LightSelection::Contribution;
+            assert_eq!(sampler.fields.is_some(), fixed && scene.emitters.len() <= FIELD_TABLE_SLOTS, "{name}");
             for i in (0..10_000).step_by(8) {
                 let u = std::array::from_fn(|l| (i + l) as f32 / 10_000.0);
                 let Some((slots, records)) = sampler.pick_fixed_lanes(u) else {
                     assert_eq!(selection, LightSelection::Contribution);
                     continue;
                 };
+                let lanes = (i as u32 * 37) & 0xff;
+                if let Some(fields) = sampler.picked_fields(slots, lanes) {
+                    for (l, record) in records.iter().enumerate() {
+                        let rows = if lanes & (1 << l) != 0 { record.rows() } else { EmitterTriangle::NONE.rows() };
+                        let row = |k: usize| fields[k].as_array_ref()[l].to_bits();
+                        assert!((0..16).all(|k| row(k) == rows[k / 8].as_array_ref()[k % 8].to_bits()));
+                    }
+                }
                 for ((e, u), slot) in records.iter().zip(u).zip(slots) {
                     let (t, p_delta) = sampler.pick(&scene, Vec3::ZERO, u).unwrap();
                     assert_eq!((scene.emitters[slot], sampler.slot(t)), (t, slot as u32));

@@ -114,8 +114,14 @@ impl EmitterLanes {
         let mut picked = 0;
         // Bit l set where lane l's slot is clear (slots past 63 never are: `clear_lights` has 32 bits).
         let (mut clear, is_clear) = (0, |slot: usize| (clear_lights as u64 >> slot.min(63)) & 1);
+        let mut fields = None;
         if let Some((slots, records)) = emitters.pick_fixed_lanes(u_light) {
-            for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
+            fields = emitters.picked_fields(slots, hit);
+            if fields.is_some() {
+                for_each_lane(hit, |l| light_error[l] = records[l].error);
+            } else {
+                for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
+            }
             picked = hit;
             if clear_lights != 0 {
                 for_each_lane(hit, |l| clear |= (is_clear(slots[l]) as u32) << l);
@@ -130,8 +136,17 @@ impl EmitterLanes {
                 }
             });
         }
-        let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
-        let [la, lb, lc] = Vec3x8::triangles(lo, cz);
+        let ([la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) = match fields {
+            // The picked records' fields, read from the sampler's vectors: the same numbers as the rows' transpose.
+            Some(f) => {
+                let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
+                ([vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]])
+            }
+            None => {
+                let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
+                (Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
+            }
+        };
         let ln = Vec3x8::new(nx, ny, nz);
         // The picked triangle's material (u32::MAX for none) and convex emitter group.
         let light_material = material.to_array().map(f32::to_bits);
