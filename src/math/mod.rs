@@ -35,6 +35,15 @@ pub fn for_each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
     }
 }
 
+/// The lane mask of a bit mask: all bits set in lane l where bit l of `bits` is (a comparison's true), none
+/// elsewhere.
+#[inline(always)]
+pub fn lane_mask(bits: u32) -> wide::i32x8 {
+    use wide::CmpEq;
+    let lanes = wide::i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
+    (wide::i32x8::splat(bits as i32) & lanes).cmp_eq(lanes)
+}
+
 /// Luminance of a linear Rec. 709 / sRGB colour (ITU-R BT.709 weights).
 #[inline]
 pub fn luminance(c: glam::Vec3) -> f32 {
@@ -52,6 +61,14 @@ mod tests {
             for_each_lane(bits, |l| seen.push(l));
             let expected: Vec<usize> = (0..32).filter(|&l| bits & (1 << l) != 0).collect();
             assert_eq!(seen, expected, "bits {bits:#b}");
+        }
+    }
+
+    #[test]
+    fn lane_mask_sets_the_lanes_of_the_bits() {
+        for bits in [0u32, 1, 0b1010_0110, 0xff, 0x1ff] {
+            let expected: [i32; 8] = std::array::from_fn(|l| if bits & (1 << l) != 0 { -1 } else { 0 });
+            assert_eq!(lane_mask(bits).to_array(), expected, "bits {bits:#b}");
         }
     }
 }

@@ -24,6 +24,25 @@ impl PixelAccum {
         self.max_luminance = self.max_luminance.max(luminance(v));
     }
 
+    /// Adds the finite samples of `values` in order, as [`PixelAccum::add`] would one by one (the same sums, bit
+    /// for bit), and returns how many were not finite (counted, never added). The sums stay in registers over the
+    /// slice, where one `add` per sample stores them and loads them back, each add waiting on the store before.
+    #[inline]
+    pub fn add_finite(&mut self, values: &[Vec3]) -> u64 {
+        let (mut sum, mut sum_sq, mut max) = (self.sum, self.sum_sq, self.max_luminance);
+        let mut added = 0;
+        for &v in values.iter().filter(|v| v.is_finite()) {
+            let d = v.as_dvec3();
+            sum += d;
+            sum_sq += d * d;
+            max = max.max(luminance(v));
+            added += 1;
+        }
+        (self.sum, self.sum_sq, self.max_luminance) = (sum, sum_sq, max);
+        self.n += added;
+        (values.len() - added as usize) as u64
+    }
+
     /// The pixel estimate: the sample mean.
     #[inline]
     pub fn mean(&self) -> DVec3 {
@@ -111,6 +130,27 @@ mod tests {
         }
         assert_eq!(p.mean(), DVec3::splat(2.5));
         assert!((p.variance().x - 5.0 / 3.0).abs() < 1e-12);
+    }
+
+    /// `add_finite` adds what `add` adds, bit for bit, and counts the non-finite samples it leaves out.
+    #[test]
+    fn add_finite_is_add_for_each_finite_sample() {
+        let values: Vec<Vec3> = (0..37)
+            .map(|i| match i % 9 {
+                4 => Vec3::new(f32::NAN, 1.0, 0.0),
+                7 => Vec3::splat(f32::INFINITY),
+                _ => Vec3::new(0.1 * i as f32, 1.0 / (i + 1) as f32, (i as f32).sqrt() * 3.7),
+            })
+            .collect();
+        let (mut one, mut each) = (PixelAccum::default(), PixelAccum::default());
+        let mut skipped = 0;
+        for chunk in values.chunks(8) {
+            skipped += one.add_finite(chunk);
+        }
+        values.iter().filter(|v| v.is_finite()).for_each(|&v| each.add(v));
+        assert_eq!(skipped, 8);
+        assert_eq!(one, each);
+        assert_eq!((one.sum.to_array().map(f64::to_bits), one.n), (each.sum.to_array().map(f64::to_bits), 29));
     }
 
     #[test]

@@ -1,5 +1,7 @@
 //! A discrete distribution over indices, proportional to non-negative weights: the p_Δ of emitter selection.
 
+use wide::{CmpGe, f32x8, i32x8};
+
 /// Walker's alias method in Vose's construction ("A Linear Algorithm for Generating Random Numbers with a Given
 /// Distribution", 1991): every index owns a bucket of width 1/n; bucket i returns i with probability q_i and its
 /// alias a_i otherwise, so that `Pr(i) = (q_i + Σ_{j: a_j = i} (1 − q_j)) / n = pmf(i)`. Sampling costs O(1)
@@ -79,6 +81,75 @@ impl DiscreteDistribution {
     pub fn pmf(&self, i: usize) -> f32 {
         self.pmf[i]
     }
+
+    /// [`DiscreteDistribution::sample_index`] as a step function of u ∈ [0, 1), for tables of at most
+    /// [`IndexSteps::MOST_BUCKETS`] buckets (`None` for larger ones).
+    pub fn steps(&self) -> Option<IndexSteps> {
+        (self.buckets.len() <= IndexSteps::MOST_BUCKETS).then(|| IndexSteps::of(self))
+    }
+}
+
+/// The alias table's index as a step function of u: on [0, 1) it is `first` below the first bound and changes
+/// by `delta` at each bound u_k (the index is `first + Σ_{k: u ≥ u_k} delta_k`). Bucket b covers the u with
+/// `⌊u n⌋ = b` (the last one up to 1) and gives b below `(b + q_b)/n`, a_b above: as the table's own test does in
+/// f64, where `u n` and `u n − b` are exact for every f32 u (24 bits times a small n; Sterbenz), so that each
+/// bound is the smallest f32 at which the test changes, found by bisection over the floats' bits and checked
+/// against the table for every u = k/2²⁴. Eight picks cost a compare, an and and an add per bound, with no
+/// table read: what a scene of a few emitter triangles spends on light selection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IndexSteps {
+    first: i32,
+    /// (u_k, delta_k), u_k increasing.
+    steps: Vec<(f32, i32)>,
+}
+
+impl IndexSteps {
+    /// The largest table kept as steps: 2n − 1 bounds at most.
+    pub const MOST_BUCKETS: usize = 8;
+
+    fn of(d: &DiscreteDistribution) -> Self {
+        let n = d.buckets.len();
+        // The smallest f32 in [lo, 1) at which the monotone predicate `after` holds (1 where none does).
+        let least = |lo: f32, after: &dyn Fn(f32) -> bool| {
+            let (mut a, mut b) = (lo.to_bits(), 1f32.to_bits());
+            while a < b {
+                let mid = a + (b - a) / 2;
+                if after(f32::from_bits(mid)) { b = mid } else { a = mid + 1 }
+            }
+            f32::from_bits(a)
+        };
+        let bucket = |u: f32| ((u as f64 * n as f64) as usize).min(n - 1);
+        let mut pieces = Vec::new();
+        let mut start = 0.0;
+        for b in 0..n {
+            let end = if b + 1 < n { least(start, &|u| bucket(u) > b) } else { 1.0 };
+            let alias_from = least(start, &|u| u >= end || d.sample_index(u) != b);
+            pieces.push((start, b as i32));
+            pieces.push((alias_from, d.buckets[b].1 as i32));
+            start = end;
+        }
+        // Each piece runs to the next one's start: the empty ones and those that repeat an index add no step.
+        let ends = pieces.iter().skip(1).map(|p| p.0).chain([1.0]);
+        let mut kept = pieces.iter().zip(ends).filter(|(p, end)| p.0 < *end).map(|(p, _)| *p);
+        let (_, first) = kept.next().expect("the pieces cover [0, 1)");
+        let (mut steps, mut index) = (Vec::new(), first);
+        for (from, i) in kept {
+            if i != index {
+                steps.push((from, i - index));
+                index = i;
+            }
+        }
+        Self { first, steps }
+    }
+
+    /// The index for each of eight uniforms in [0, 1): what [`DiscreteDistribution::sample_index`] gives.
+    #[inline(always)]
+    pub fn indices(&self, u: f32x8) -> i32x8 {
+        self.steps.iter().fold(i32x8::splat(self.first), |index, &(bound, delta)| {
+            let past: i32x8 = bytemuck::cast(u.cmp_ge(f32x8::splat(bound)));
+            index + (past & i32x8::splat(delta))
+        })
+    }
 }
 
 #[cfg(test)]
@@ -129,6 +200,43 @@ mod tests {
                 assert_eq!(d.sample_indices(u), u.map(|u| d.sample_index(u)), "{weights:?} at {u:?}");
             }
         }
+    }
+
+    /// The steps give the table's index for every u = k/2²⁴ (all the values `SampleRng::uniform` gives) and for
+    /// 10⁶ other floats in [0, 1), on tables of one to eight buckets: equal weights (no alias taken), zeros
+    /// (a bucket that is all alias), weights of very different sizes and weights whose shares are not
+    /// multiples of 1/n.
+    #[test]
+    fn steps_give_the_tables_index() {
+        let tables: [Vec<f64>; 6] = [
+            vec![2.0],
+            vec![1.0, 1.0],
+            vec![1.0, 0.0, 3.0],
+            vec![0.1, 1e-9, 5.0, 0.3],
+            (0..7).map(|i| ((i * 7) % 11) as f64 + 0.3).collect(),
+            (0..8).map(|i| (i as f64 * 0.37).exp() % 7.0).collect(),
+        ];
+        for weights in tables {
+            let d = DiscreteDistribution::new(&weights).unwrap();
+            let steps = d.steps().expect("a small table");
+            assert!(steps.steps.len() < 2 * weights.len(), "{weights:?}: {} steps", steps.steps.len());
+            let check = |u: [f32; 8]| {
+                let got: [i32; 8] = steps.indices(f32x8::new(u)).to_array();
+                assert_eq!(got, u.map(|u| d.sample_index(u) as i32), "{weights:?} at {u:?}");
+            };
+            for k in (0..1u32 << 24).step_by(8) {
+                check(std::array::from_fn(|l| (k + l as u32) as f32 / (1u32 << 24) as f32));
+            }
+            let mut bits = 0x9e37_79b9u32;
+            for _ in 0..125_000 {
+                check(std::array::from_fn(|_| {
+                    bits = bits.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+                    f32::from_bits(bits % 1f32.to_bits())
+                }));
+            }
+        }
+        let big = DiscreteDistribution::new(&[1.0; IndexSteps::MOST_BUCKETS + 1]).unwrap();
+        assert!(big.steps().is_none());
     }
 
     #[test]

@@ -12,7 +12,7 @@ mod spherical_triangle;
 mod spherical_triangle_lanes;
 mod triangle;
 
-pub use discrete::DiscreteDistribution;
+pub use discrete::{DiscreteDistribution, IndexSteps};
 pub use hemisphere::{
     cosine_hemisphere_pdf, sample_cosine_hemisphere, sample_uniform_hemisphere, uniform_hemisphere_pdf,
 };

@@ -1,10 +1,10 @@
 //! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
 use super::{SKIP_NONE, Scene};
-use crate::math::{SurfaceError, Vec3x8, luminance};
-use crate::sampling::DiscreteDistribution;
+use crate::math::{SurfaceError, Vec3x8, lane_mask, luminance};
+use crate::sampling::{DiscreteDistribution, IndexSteps};
 use glam::Vec3;
-use wide::f32x8;
+use wide::{f32x8, i32x8};
 
 /// How p_Δ is chosen.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -52,14 +52,21 @@ pub struct EmitterSampler {
     /// What light sampling reads of each slot's triangle, with its p_Δ, for the selections that do not depend on
     /// the shading point (empty for the others).
     records: Vec<EmitterTriangle>,
-    /// For at most [`FIELD_TABLE_SLOTS`] records: field k of every record's rows ([`EmitterTriangle::rows`]) in
-    /// one vector, record s in lane s, [`EmitterTriangle::NONE`]'s in the lanes after them: eight picks read
-    /// each field with one permute instead of sixteen loads and two transposes.
-    fields: Option<[f32x8; 16]>,
+    /// The records in vectors, for at most [`FIELD_TABLE_SLOTS`] of them.
+    table: Option<FieldTable>,
 }
 
-/// The most records [`EmitterSampler::picked_fields`] holds in vectors (lane 7 stands for no light).
+/// The most records [`EmitterSampler::pick_fields`] holds in vectors (lane 7 stands for no light).
 const FIELD_TABLE_SLOTS: usize = 7;
+
+/// A few records as vectors: field k of every record's rows ([`EmitterTriangle::rows`]) in one vector, record s
+/// in lane s, [`EmitterTriangle::NONE`]'s in the lanes after them, and the alias table as a step function of u
+/// ([`IndexSteps`]): eight picks take a compare, an and and an add per step, then read each field with one
+/// permute, instead of eight table walks, sixteen loads and two transposes.
+struct FieldTable {
+    steps: IndexSteps,
+    fields: [f32x8; 16],
+}
 
 /// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
 /// holds what sampling reads, the second the offset bounds the shadow ray reads later): picking one costs one
@@ -146,11 +153,13 @@ impl EmitterSampler {
             let record = |(slot, &t): (usize, &u32)| EmitterTriangle::of(scene, t, distribution.pmf(slot));
             scene.emitters.iter().enumerate().map(record).collect()
         };
-        let fields = (!records.is_empty() && records.len() <= FIELD_TABLE_SLOTS).then(|| {
+        let small = !records.is_empty() && records.len() <= FIELD_TABLE_SLOTS;
+        let table = distribution.steps().filter(|_| small).map(|steps| {
             let rows = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).rows();
-            std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| rows(s)[k / 8].as_array_ref()[k % 8])))
+            let field = |k: usize| f32x8::new(std::array::from_fn(|s| rows(s)[k / 8].as_array_ref()[k % 8]));
+            FieldTable { steps, fields: std::array::from_fn(field) }
         });
-        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, fields })
+        Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, table })
     }
 
     pub fn selection(&self) -> LightSelection {
@@ -174,14 +183,21 @@ impl EmitterSampler {
         Some((slots, slots.map(|i| &self.records[i])))
     }
 
-    /// Field k ([`EmitterTriangle::rows`]' k-th value) of the record picked in each lane: slot `slots[l]` in the
-    /// lanes of `lanes` (bit l for lane l), [`EmitterTriangle::NONE`]'s elsewhere. `None` where the records are
+    /// What [`EmitterSampler::pick`] picks for eight uniforms, in the lanes of `lanes` (bit l for lane l): the
+    /// slot picked with `u`'s lane l in lane l (7 in the other lanes), and field k ([`EmitterTriangle::rows`]'
+    /// k-th value) of its record ([`EmitterTriangle::NONE`]'s in the other lanes). `None` where the records are
     /// not held in vectors (more than seven, or a selection that depends on the shading point).
     #[inline(always)]
-    pub fn picked_fields(&self, slots: [usize; 8], lanes: u32) -> Option<[f32x8; 16]> {
-        let fields = self.fields.as_ref()?;
-        let index: [i32; 8] = std::array::from_fn(|l| if lanes & (1 << l) != 0 { slots[l] as i32 } else { 7 });
-        Some(fields.map(|field| lane_lookup(field, index)))
+    pub fn pick_fields(&self, u: f32x8, lanes: u32) -> Option<(i32x8, [f32x8; 16])> {
+        let table = self.table.as_ref()?;
+        let slots = lane_mask(lanes).blend(table.steps.indices(u), i32x8::splat(7));
+        Some((slots, table.fields.map(|field| lane_lookup(field, slots))))
+    }
+
+    /// The record of slot `slot`, for the selections that do not depend on the shading point.
+    #[inline(always)]
+    pub fn record(&self, slot: usize) -> &EmitterTriangle {
+        &self.records[slot]
     }
 
     /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
@@ -256,7 +272,7 @@ fn contribution(scene: &Scene, t: u32, p: Vec3) -> f64 {
 
 /// Lane `index[l]` of `table` in lane l (each index below 8): one `vpermps` where the build has AVX2.
 #[inline(always)]
-fn lane_lookup(table: f32x8, index: [i32; 8]) -> f32x8 {
+fn lane_lookup(table: f32x8, index: i32x8) -> f32x8 {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
     {
         let index: safe_arch::m256i = bytemuck::cast(index);
@@ -264,7 +280,7 @@ fn lane_lookup(table: f32x8, index: [i32; 8]) -> f32x8 {
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
     {
-        f32x8::new(index.map(|i| table.as_array_ref()[i as usize]))
+        f32x8::new(index.to_array().map(|i| table.as_array_ref()[i as usize]))
     }
 }
 
@@ -282,7 +298,7 @@ mod tests {
             let scene = load_scene(name).unwrap();
             let sampler = EmitterSampler::new(&scene, selection).unwrap();
             let fixed = selection != LightSelection::Contribution;
-            assert_eq!(sampler.fields.is_some(), fixed && scene.emitters.len() <= FIELD_TABLE_SLOTS, "{name}");
+            assert_eq!(sampler.table.is_some(), fixed && scene.emitters.len() <= FIELD_TABLE_SLOTS, "{name}");
             for i in (0..10_000).step_by(8) {
                 let u = std::array::from_fn(|l| (i + l) as f32 / 10_000.0);
                 let Some((slots, records)) = sampler.pick_fixed_lanes(u) else {
@@ -290,9 +306,12 @@ mod tests {
                     continue;
                 };
                 let lanes = (i as u32 * 37) & 0xff;
-                if let Some(fields) = sampler.picked_fields(slots, lanes) {
+                if let Some((picked, fields)) = sampler.pick_fields(f32x8::new(u), lanes) {
                     for (l, record) in records.iter().enumerate() {
-                        let rows = if lanes & (1 << l) != 0 { record.rows() } else { EmitterTriangle::NONE.rows() };
+                        let on = lanes & (1 << l) != 0;
+                        assert_eq!(picked.as_array_ref()[l], if on { slots[l] as i32 } else { 7 });
+                        assert!(std::ptr::eq(sampler.record(slots[l]), *record));
+                        let rows = if on { record.rows() } else { EmitterTriangle::NONE.rows() };
                         let row = |k: usize| fields[k].as_array_ref()[l].to_bits();
                         assert!((0..16).all(|k| row(k) == rows[k / 8].as_array_ref()[k % 8].to_bits()));
                     }

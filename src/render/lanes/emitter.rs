@@ -6,7 +6,7 @@
 //! bit.
 
 use super::{LANES, mis_brdf_technique, mis_sums};
-use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane};
+use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
@@ -78,9 +78,7 @@ impl EmitterLanes {
         let ([a, b, c], [nx, ny, nz], p_error) = if hit != 0 && same & hit == hit {
             let tri = &scene.triangles[first as usize];
             for_each_lane(hit, |l| materials[l] = tri.material);
-            // All bits set in the lanes that hit (a comparison's true).
-            let bits = i32x8::new(std::array::from_fn(|l| 1 << l));
-            let on: f32x8 = cast((i32x8::splat(hit as i32) & bits).cmp_eq(bits));
+            let on: f32x8 = cast(lane_mask(hit));
             let vertex = |v: Vec3| Vec3x8::select(on, Vec3x8::splat(v), Vec3x8::splat(Vec3::ZERO));
             let n = vertex(tri.n);
             (tri.v.map(vertex), [n.x, n.y, n.z], on.blend(f32x8::splat(tri.error.at_point), f32x8::ZERO))
@@ -104,49 +102,50 @@ impl EmitterLanes {
         let n = Vec3x8::select(facing.cmp_lt(f32x8::ZERO), -geometric, geometric);
         let front = facing.cmp_gt(f32x8::ZERO).move_mask() as u32;
 
-        // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. The picked
-        // records' rows transpose into one vector per field; a lane with no light keeps `EmitterTriangle::NONE`.
-        // The records are read once every lane has picked, so that their loads wait on the alias table together.
-        let none = EmitterTriangle::NONE.rows();
-        let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
+        // Light selection per lane (p_Δ may depend on the shading point), then a uniform point x on Δ. A few
+        // records held in vectors are picked in f32x8 (`EmitterSampler::pick_fields`); otherwise the picked
+        // records' rows transpose into one vector per field, read once every lane has picked, so that their
+        // loads wait on the alias table together. A lane with no light keeps `EmitterTriangle::NONE`.
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
-        let (u_light, u_point) = (rngs.uniform().to_array(), [rngs.uniform(), rngs.uniform()]);
-        let mut picked = 0;
-        // Bit l set where lane l's slot is clear (slots past 63 never are: `clear_lights` has 32 bits).
-        let (mut clear, is_clear) = (0, |slot: usize| (clear_lights as u64 >> slot.min(63)) & 1);
-        let mut fields = None;
-        if let Some((slots, records)) = emitters.pick_fixed_lanes(u_light) {
-            fields = emitters.picked_fields(slots, hit);
-            if fields.is_some() {
-                for_each_lane(hit, |l| light_error[l] = records[l].error);
-            } else {
-                for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
-            }
-            picked = hit;
-            if clear_lights != 0 {
-                for_each_lane(hit, |l| clear |= (is_clear(slots[l]) as u32) << l);
-            }
-        } else {
-            for_each_lane(hit, |l| {
-                if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
-                    let record = EmitterTriangle::of(scene, t, p_delta);
-                    ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
-                    picked |= 1 << l;
-                    clear |= (is_clear(emitters.slot(t) as usize) as u32) << l;
+        let (u_light, u_point) = (rngs.uniform(), [rngs.uniform(), rngs.uniform()]);
+        let (mut picked, mut clear) = (0, 0);
+        let ([la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) =
+            if let Some((slots, f)) = emitters.pick_fields(u_light, hit) {
+                let slot = slots.to_array();
+                for_each_lane(hit, |l| light_error[l] = emitters.record(slot[l] as usize).error);
+                picked = hit;
+                if clear_lights != 0 {
+                    // Bit s of `clear_lights` in the lane that picked slot s (below 7: no shift passes 31).
+                    let is_clear = (i32x8::splat(clear_lights as i32) >> slots) & i32x8::ONE;
+                    clear = is_clear.cmp_eq(i32x8::ONE).move_mask() as u32 & hit;
                 }
-            });
-        }
-        let ([la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) = match fields {
-            // The picked records' fields, read from the sampler's vectors: the same numbers as the rows' transpose.
-            Some(f) => {
                 let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
                 ([vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]])
-            }
-            None => {
+            } else {
+                let none = EmitterTriangle::NONE.rows();
+                let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
+                // Bit l set where lane l's slot is clear (slots past 63 never are: `clear_lights` has 32 bits).
+                let is_clear = |slot: usize| (clear_lights as u64 >> slot.min(63)) & 1;
+                let u_light = u_light.to_array();
+                if let Some((slots, records)) = emitters.pick_fixed_lanes(u_light) {
+                    for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
+                    picked = hit;
+                    if clear_lights != 0 {
+                        for_each_lane(hit, |l| clear |= (is_clear(slots[l]) as u32) << l);
+                    }
+                } else {
+                    for_each_lane(hit, |l| {
+                        if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
+                            let record = EmitterTriangle::of(scene, t, p_delta);
+                            ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
+                            picked |= 1 << l;
+                            clear |= (is_clear(emitters.slot(t) as usize) as u32) << l;
+                        }
+                    });
+                }
                 let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
                 (Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
-            }
-        };
+            };
         let ln = Vec3x8::new(nx, ny, nz);
         // The picked triangle's material (u32::MAX for none) and convex emitter group.
         let light_material = material.to_array().map(f32::to_bits);

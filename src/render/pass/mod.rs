@@ -267,7 +267,11 @@ impl Renderer {
                             let learned = learned.as_deref_mut();
                             let cone = (cone.as_ref(), clear_lights);
                             let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
-                            values[..n].iter().for_each(|&v| add(acc, v));
+                            if keep {
+                                stats.non_finite += acc.add_finite(&values[..n]);
+                            } else {
+                                stats.non_finite += values[..n].iter().filter(|v| !v.is_finite()).count() as u64;
+                            }
                         }
                     }
                 }
