@@ -44,6 +44,19 @@ pub fn lane_mask(bits: u32) -> wide::i32x8 {
     (wide::i32x8::splat(bits as i32) & lanes).cmp_eq(lanes)
 }
 
+/// The lanes l whose index `indices[l]` is in the set `set` (bit i for index i, i < 31; other indices, negative
+/// ones too, are in none), as a bit mask.
+#[inline(always)]
+pub fn lanes_in(set: u32, indices: wide::i32x8) -> u32 {
+    use wide::{CmpEq, CmpLt, i32x8};
+    // Negative indices and those past 30 shift to bit 31, which is clear.
+    let last = i32x8::splat(31);
+    let shift = indices.cmp_lt(i32x8::ZERO).blend(last, indices.min(last));
+    let bit = (i32x8::splat((set & !(1 << 31)) as i32) >> shift) & i32x8::ONE;
+    let on: wide::f32x8 = bytemuck::cast(bit.cmp_eq(i32x8::ONE));
+    on.move_mask() as u32
+}
+
 /// Luminance of a linear Rec. 709 / sRGB colour (ITU-R BT.709 weights).
 #[inline]
 pub fn luminance(c: glam::Vec3) -> f32 {
@@ -62,6 +75,14 @@ mod tests {
             let expected: Vec<usize> = (0..32).filter(|&l| bits & (1 << l) != 0).collect();
             assert_eq!(seen, expected, "bits {bits:#b}");
         }
+    }
+
+    #[test]
+    fn lanes_in_reads_each_lanes_bit_of_the_set() {
+        let indices = wide::i32x8::new([0, 1, 2, 7, 30, 31, 40, -1]);
+        assert_eq!(lanes_in(0b1000_0101, indices), 0b1101);
+        assert_eq!(lanes_in(u32::MAX, indices), 0b1_1111, "indices past 30 and negative ones are in none");
+        assert_eq!(lanes_in(0, indices), 0);
     }
 
     #[test]

@@ -5,9 +5,9 @@ use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
 use crate::math::{SampleRng, SurfaceError, Vec3x8, offset_ray_origin, offset_ray_origins};
-use crate::scene::{EmitterSampler, SKIP_NONE, Scene};
+use crate::scene::{EmitterSampler, SKIP_NONE, Scene, ShadowBlockers};
 use glam::Vec3;
-use wide::{CmpGt, f32x8};
+use wide::{CmpGt, f32x8, i32x8};
 
 /// Estimates the reflected radiance at `sp` with one sample of the settings' strategy. Returns the contribution
 /// (possibly non-finite for pathological input: callers drop and count such samples) and adds the rays traced.
@@ -176,7 +176,8 @@ pub(super) fn shadow_ray_ends_lanes(
 /// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i): the
 /// shading points (p, n, their bounds), the points x on the lights with their normals, lane i's x on a triangle
 /// with bounds `far[i]` of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible ones.
-/// Lane i's answer is `visible`'s, bit for bit.
+/// With `blockers` (the tile's, and each lane's emitter slot), the lanes whose slot it lists meet its triangles
+/// alone; the others walk the tree. Lane i's answer is `visible`'s, bit for bit.
 #[inline]
 pub(super) fn visible_lanes(
     scene: &Scene,
@@ -184,6 +185,7 @@ pub(super) fn visible_lanes(
     (x, n_x): (Vec3x8, Vec3x8),
     (far, groups): (&[SurfaceError; 8], [u32; 8]),
     active: u32,
+    blockers: Option<(&ShadowBlockers, i32x8)>,
     rays: &mut u64,
 ) -> u32 {
     if active == 0 {
@@ -191,12 +193,22 @@ pub(super) fn visible_lanes(
     }
     *rays += active.count_ones() as u64;
     let (from, to) = shadow_ray_ends_lanes(near, (x, n_x), far);
-    let mut skips = [SKIP_NONE; 8];
-    if groups != skips {
-        let in_front = n_x.dot(from - x).cmp_gt(f32x8::ZERO).move_mask();
-        skips = std::array::from_fn(|l| if in_front & (1 << l) != 0 { groups[l] } else { SKIP_NONE });
+    let mut occluded = 0;
+    let mut walking = active;
+    if let Some((blockers, slots)) = blockers {
+        let listed = active & blockers.listed(slots);
+        occluded = blockers.occluded_lanes(&from, &(to - from), SEGMENT_END, listed, slots);
+        walking &= !listed;
     }
-    active & !scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, active, skips)
+    if walking != 0 {
+        let mut skips = [SKIP_NONE; 8];
+        if groups != skips {
+            let in_front = n_x.dot(from - x).cmp_gt(f32x8::ZERO).move_mask();
+            skips = std::array::from_fn(|l| if in_front & (1 << l) != 0 { groups[l] } else { SKIP_NONE });
+        }
+        occluded |= scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, walking, skips);
+    }
+    active & !occluded
 }
 
 /// Shadow rays run along `from + t·(to − from)` for 0 < t < 1 − 10⁻⁶ (the direction is not a unit vector).

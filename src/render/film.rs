@@ -4,6 +4,7 @@
 
 use crate::math::luminance;
 use glam::{DVec3, Vec3};
+use wide::f64x4;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelAccum {
@@ -29,16 +30,19 @@ impl PixelAccum {
     /// slice, where one `add` per sample stores them and loads them back, each add waiting on the store before.
     #[inline]
     pub fn add_finite(&mut self, values: &[Vec3]) -> u64 {
-        let (mut sum, mut sum_sq, mut max) = (self.sum, self.sum_sq, self.max_luminance);
+        // x, y, z in lanes 0–2 of f64x4: each lane's sums are the scalar ones (lane 3 sums zeros).
+        let four = |v: DVec3| f64x4::new([v.x, v.y, v.z, 0.0]);
+        let (mut sum, mut sum_sq, mut max) = (four(self.sum), four(self.sum_sq), self.max_luminance);
         let mut added = 0;
         for &v in values.iter().filter(|v| v.is_finite()) {
-            let d = v.as_dvec3();
+            let d = f64x4::new([v.x as f64, v.y as f64, v.z as f64, 0.0]);
             sum += d;
             sum_sq += d * d;
             max = max.max(luminance(v));
             added += 1;
         }
-        (self.sum, self.sum_sq, self.max_luminance) = (sum, sum_sq, max);
+        let three = |v: f64x4| DVec3::from_slice(&v.as_array_ref()[..3]);
+        (self.sum, self.sum_sq, self.max_luminance) = (three(sum), three(sum_sq), max);
         self.n += added;
         (values.len() - added as usize) as u64
     }

@@ -4,7 +4,6 @@
 mod accel;
 mod bundled;
 mod camera;
-mod clear_lights;
 mod convex;
 mod emitter_tree;
 mod emitters;
@@ -14,11 +13,13 @@ mod load;
 mod material;
 mod mtl;
 mod obj;
+mod tile_lights;
 
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
 pub use accel::{
-    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, Shaft, VectorPath, has_avx512, vector_path,
+    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, VectorPath, has_avx512,
+    vector_path,
 };
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
@@ -30,6 +31,7 @@ pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
 pub use load::{load_scene, load_scene_file, load_scene_from_bytes};
 pub use material::Material;
+pub use tile_lights::TileLights;
 
 use crate::math::SurfaceError;
 use glam::Vec3;

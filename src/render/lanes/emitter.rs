@@ -6,12 +6,12 @@
 //! bit.
 
 use super::{LANES, mis_brdf_technique, mis_sums};
-use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask};
+use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask, lanes_in};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
 use crate::render::strategy::{Brdf, Emitter, SampleContext, Technique};
-use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene};
+use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene, TileLights};
 use bytemuck::cast;
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -45,8 +45,10 @@ struct EmitterLanes {
     wi: Vec3x8,
     pdf: [f32; LANES],
     cos: [f32; LANES],
-    /// The lanes whose picked light is one of the pixel's clear lights (`Scene::clear_lights`): their shadow
-    /// rays get through, found without tracing them.
+    /// Each lane's emitter slot (meaningful in the lanes of `picked`).
+    slots: i32x8,
+    /// The lanes whose picked light is one of the tile's clear lights (`TileLights::clear`): their shadow rays
+    /// get through, found without tracing them.
     clear: u32,
     /// The lanes whose direction is a sample that can contribute: on the emitting side, at a positive finite
     /// density, above the surface.
@@ -55,11 +57,11 @@ struct EmitterLanes {
 
 impl EmitterLanes {
     /// Draws each lane's direction: the light's uniform, then the point's two, from lane l of `rngs` (every lane
-    /// draws all three, used or not). `clear_lights` has bit s set for the pixel's clear emitter slots s.
+    /// draws all three, used or not). `tile` says which of the pixel's shadow rays are clear.
     #[inline(always)]
     fn draw(
         scene: &Scene,
-        (emitters, clear_lights): (&EmitterSampler, u32),
+        (emitters, tile): (&EmitterSampler, &TileLights),
         dirs: &Vec3x8,
         hits: &HitLanes,
         rngs: &mut SampleRngLanes,
@@ -108,44 +110,39 @@ impl EmitterLanes {
         // loads wait on the alias table together. A lane with no light keeps `EmitterTriangle::NONE`.
         let mut light_error = [EmitterTriangle::NONE.error; LANES];
         let (u_light, u_point) = (rngs.uniform(), [rngs.uniform(), rngs.uniform()]);
-        let (mut picked, mut clear) = (0, 0);
-        let ([la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) =
+        let mut picked = 0;
+        let (slots, [la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) =
             if let Some((slots, f)) = emitters.pick_fields(u_light, hit) {
                 let slot = slots.to_array();
                 for_each_lane(hit, |l| light_error[l] = emitters.record(slot[l] as usize).error);
                 picked = hit;
-                if clear_lights != 0 {
-                    // Bit s of `clear_lights` in the lane that picked slot s (below 7: no shift passes 31).
-                    let is_clear = (i32x8::splat(clear_lights as i32) >> slots) & i32x8::ONE;
-                    clear = is_clear.cmp_eq(i32x8::ONE).move_mask() as u32 & hit;
-                }
                 let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
-                ([vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]])
+                (slots, [vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]])
             } else {
                 let none = EmitterTriangle::NONE.rows();
                 let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
-                // Bit l set where lane l's slot is clear (slots past 63 never are: `clear_lights` has 32 bits).
-                let is_clear = |slot: usize| (clear_lights as u64 >> slot.min(63)) & 1;
+                let mut slots = [-1; LANES];
                 let u_light = u_light.to_array();
-                if let Some((slots, records)) = emitters.pick_fixed_lanes(u_light) {
-                    for_each_lane(hit, |l| ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error));
+                if let Some((picks, records)) = emitters.pick_fixed_lanes(u_light) {
+                    for_each_lane(hit, |l| {
+                        ([lo[l], hi[l]], light_error[l]) = (records[l].rows(), records[l].error);
+                        slots[l] = picks[l] as i32;
+                    });
                     picked = hit;
-                    if clear_lights != 0 {
-                        for_each_lane(hit, |l| clear |= (is_clear(slots[l]) as u32) << l);
-                    }
                 } else {
                     for_each_lane(hit, |l| {
                         if let Some((t, p_delta)) = emitters.pick(scene, p.lane(l), u_light[l]) {
                             let record = EmitterTriangle::of(scene, t, p_delta);
                             ([lo[l], hi[l]], light_error[l]) = (record.rows(), record.error);
                             picked |= 1 << l;
-                            clear |= (is_clear(emitters.slot(t) as usize) as u32) << l;
+                            slots[l] = emitters.slot(t) as i32;
                         }
                     });
                 }
                 let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
-                (Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
+                (i32x8::new(slots), Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
             };
+        let clear = lanes_in(tile.clear, slots) & picked;
         let ln = Vec3x8::new(nx, ny, nz);
         // The picked triangle's material (u32::MAX for none) and convex emitter group.
         let light_material = material.to_array().map(f32::to_bits);
@@ -184,6 +181,7 @@ impl EmitterLanes {
             light_material,
             light_group,
             light_error,
+            slots,
             wi,
             pdf: pdf.to_array(),
             cos: cos.to_array(),
@@ -202,13 +200,16 @@ impl EmitterLanes {
     }
 
     /// The lanes of `active` whose shadow ray gets through; adds the shadow rays to `rays` (those to a clear
-    /// light are answered without being traced).
+    /// light are answered without being traced, those to a light with the tile's blockers listed meet only
+    /// them).
     #[inline(always)]
-    fn visible(&self, scene: &Scene, active: u32, rays: &mut u64) -> u32 {
-        let (near, far) = ((self.p, self.n, self.p_error), (self.x, self.ln));
+    fn visible(&self, scene: &Scene, tile: &TileLights, active: u32, rays: &mut u64) -> u32 {
+        let (near, far, lights) =
+            ((self.p, self.n, self.p_error), (self.x, self.ln), (&self.light_error, self.light_group));
         let clear = active & self.clear;
         *rays += clear.count_ones() as u64;
-        clear | visible_lanes(scene, near, far, (&self.light_error, self.light_group), active & !clear, rays)
+        let blockers = tile.blockers.as_deref().map(|b| (b, self.slots));
+        clear | visible_lanes(scene, near, far, lights, active & !clear, blockers, rays)
     }
 }
 
@@ -218,7 +219,7 @@ impl EmitterLanes {
 #[inline]
 pub fn estimate_emitter_lanes(
     scene: &Scene,
-    lights: (&EmitterSampler, u32),
+    lights: (&EmitterSampler, &TileLights),
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
@@ -270,7 +271,7 @@ pub fn estimate_emitter_lanes(
             }
         });
     }
-    let visible = e.visible(scene, shadow_rays, rays);
+    let visible = e.visible(scene, lights.1, shadow_rays, rays);
     std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
 }
 
@@ -284,7 +285,7 @@ pub fn estimate_emitter_lanes(
 #[inline(never)]
 pub fn estimate_mis_emitter_brdf_lanes(
     ctx: &SampleContext,
-    lights: (&EmitterSampler, u32),
+    lights: (&EmitterSampler, &TileLights),
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
@@ -343,7 +344,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let mut streams = rngs.with_lanes_after(&before, !(e.picked & e.faces), 1);
     let near = (e.p, e.n, e.wo, e.p_error);
     let from_brdf = mis_brdf_technique(&contexts, &Emitter, &materials, near, &mut streams, rays);
-    let visible = e.visible(scene, shadow_rays, rays);
+    let visible = e.visible(scene, lights.1, shadow_rays, rays);
     mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }
 
@@ -380,8 +381,14 @@ mod tests {
                     }));
                     let (mut simd_rays, mut lane_rays) = (0, 0);
                     let mut lane_rngs = std::array::from_fn(|l| rngs.lane(l));
-                    let simd =
-                        estimate_mis_emitter_brdf_lanes(&ctx, (&emitters, 0), &dirs, &hits, &mut rngs, &mut simd_rays);
+                    let simd = estimate_mis_emitter_brdf_lanes(
+                        &ctx,
+                        (&emitters, &TileLights::NONE),
+                        &dirs,
+                        &hits,
+                        &mut rngs,
+                        &mut simd_rays,
+                    );
                     let by_lane =
                         estimate_mis_lanes(&ctx, (&Emitter, &Brdf), &dirs, &hits, &mut lane_rngs, &mut lane_rays);
                     for l in 0..n {

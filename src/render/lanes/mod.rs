@@ -158,7 +158,7 @@ impl ShadowRays {
         }
         let [p, n, x, n_x] = self.ends.map(|e| Vec3x8::from_lanes(&e));
         let near = (p, n, f32x8::new(self.p_error));
-        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, rays)
+        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, None, rays)
     }
 }
 

@@ -11,7 +11,9 @@ use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleCon
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::guiding::{Guide, GuideRecord, GuideSettings, LeafHint, Training};
 use crate::math::{PixelStreams, SampleRng};
-use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene};
+use crate::scene::{
+    Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene, TileLights,
+};
 use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
@@ -258,14 +260,14 @@ impl Renderer {
                     let mut cones = (self.settings.footprint == Footprint::Jittered)
                         .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
                     for (x, acc) in row.iter_mut().enumerate() {
-                        let (cone, clear_lights) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, 0));
+                        let (cone, tile) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, &TileLights::NONE));
                         let streams = streams(x);
                         for group in (first..first + count).step_by(LANES) {
                             let samples = group..(group + LANES as u32).min(first + count);
                             let n = samples.len();
                             let pixel = (x as u32, y as u32);
                             let learned = learned.as_deref_mut();
-                            let cone = (cone.as_ref(), clear_lights);
+                            let cone = (cone.as_ref(), tile);
                             let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
                             if keep {
                                 stats.non_finite += acc.add_finite(&values[..n]);
@@ -334,15 +336,14 @@ impl Renderer {
 
     /// Samples `samples` (at most eight) of pixel (x, y), one per lane; lane l gets what [`Self::camera_ray`] and
     /// [`Self::shade`] give sample `samples.start + l`, bit for bit. `cone`, when given, holds every triangle the
-    /// pixel's camera rays can hit; `clear_lights` has bit s set for the emitter slots s that every shadow ray
-    /// from the pixel reaches (`Scene::clear_lights`).
+    /// pixel's camera rays can hit; `tile` what its shadow rays can meet (`Scene::tile_lights`).
     #[inline]
     fn sample_lanes(
         &self,
         (x, y): (u32, u32),
         streams: &PixelStreams,
         samples: Range<u32>,
-        (cone, clear_lights): (Option<&ConeCandidates>, u32),
+        (cone, tile): (Option<&ConeCandidates>, &TileLights),
         rays: &mut u64,
         mut learned: Option<&mut Vec<GuideRecord>>,
     ) -> [Vec3; LANES] {
@@ -370,7 +371,7 @@ impl Renderer {
         let strategy = self.settings.strategy;
         match (strategy, &self.emitters) {
             (Strategy::Emitter, Some(emitters)) => {
-                estimate_emitter_lanes(&self.scene, (emitters, clear_lights), &dirs, &hits, &mut rngs, rays)
+                estimate_emitter_lanes(&self.scene, (emitters, tile), &dirs, &hits, &mut rngs, rays)
             }
             (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
@@ -413,7 +414,7 @@ impl Renderer {
                     && self.settings.mis.samples == [1, 1]
                     && self.settings.mis.techniques == [Strategy::Emitter, Strategy::Brdf] =>
             {
-                let lights = (emitters, clear_lights);
+                let lights = (emitters, tile);
                 estimate_mis_emitter_brdf_lanes(&self.context(), lights, &dirs, &hits, &mut rngs, rays)
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.

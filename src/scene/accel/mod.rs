@@ -8,6 +8,7 @@
 
 #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
 mod avx512;
+mod blockers;
 mod build;
 mod frustum;
 mod node;
@@ -18,6 +19,7 @@ mod shaft;
 mod traverse;
 mod vectors;
 
+pub use blockers::ShadowBlockers;
 pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};

@@ -166,9 +166,16 @@ impl TrianglePacket {
     pub fn any_of_rays(&self, rays: &RayLanes, t_max: f32) -> u32 {
         let mut hit = 0;
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            hit |= self.test_rays(k, &rays.o, &rays.d, f32x8::splat(t_max)).0.move_mask() as u32;
+            hit |= self.rays_hitting(k, rays, t_max);
         }
         hit
+    }
+
+    /// The rays of `rays` that hit the triangle in lane `k` at `0 < t < t_max` (bit i for ray i): what
+    /// [`TrianglePacket::any_of_rays`] finds for that triangle alone.
+    #[inline(always)]
+    pub fn rays_hitting(&self, k: usize, rays: &RayLanes, t_max: f32) -> u32 {
+        self.test_rays(k, &rays.o, &rays.d, f32x8::splat(t_max)).0.move_mask() as u32
     }
 
     /// v₀, e₁ and e₂ of the eight lanes.

@@ -137,18 +137,25 @@ impl TrianglePacket {
 }
 
 impl Accel {
-    /// Whether every triangle either meets no segment in `shaft` or is one `left_out` names (by id): then no
-    /// segment between the shaft's patches is stopped by any other. False as well when the walk would look at
-    /// more than `budget` nodes and leaves (a shaft that crosses much of a large scene is not worth its cost).
-    pub fn shaft_is_clear(&self, shaft: &Shaft, left_out: impl Fn(u32) -> bool, budget: u32) -> bool {
-        let Some(root) = self.root else { return true };
+    /// The ids of the triangles that may meet a segment in `shaft`, but for those `left_out` names: every
+    /// triangle that can stop such a segment. `None` where there are more than `most` (at most eight), or the walk
+    /// would look at more than `budget` nodes and leaves.
+    pub fn shaft_blockers(
+        &self,
+        shaft: &Shaft,
+        left_out: impl Fn(u32) -> bool,
+        budget: u32,
+        most: usize,
+    ) -> Option<ArrayVec<u32, 8>> {
+        let mut found = ArrayVec::new();
+        let Some(root) = self.root else { return Some(found) };
         let mut stack = ArrayVec::<Child, STACK>::new();
         stack.push(root);
         let mut visits = 0;
         while let Some(child) = stack.pop() {
             visits += 1;
             if visits > budget {
-                return false;
+                return None;
             }
             if child.is_leaf() {
                 for packet in &self.packets[child.first as usize..(child.first + child.packets) as usize] {
@@ -157,7 +164,10 @@ impl Accel {
                         let lane = open.trailing_zeros() as usize;
                         let id = packet.ids[lane];
                         if !left_out(id) && !packet.vertices(lane).is_some_and(|v| shaft.clears(v)) {
-                            return false;
+                            if found.len() == most.min(8) {
+                                return None;
+                            }
+                            found.push(id);
                         }
                         open &= open - 1;
                     }
@@ -171,7 +181,7 @@ impl Accel {
                 }
             }
         }
-        true
+        Some(found)
     }
 }
 
