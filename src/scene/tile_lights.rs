@@ -25,7 +25,7 @@ const MAX_SHAFT_LIGHTS: usize = 8;
 const SHAFT_BUDGET: u32 = 256;
 
 /// Tiles whose candidates lie in more planes than this get nothing (a shaft per plane per light).
-const MAX_PLANES: usize = 3;
+const MAX_PLANES: usize = 2;
 
 /// What a tile's shadow rays to each emitter slot s (`Scene::emitters[s]`) can meet.
 #[derive(Clone, Debug, Default)]

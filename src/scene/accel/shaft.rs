@@ -138,8 +138,8 @@ impl TrianglePacket {
 
 impl Accel {
     /// The ids of the triangles that may meet a segment in `shaft`, but for those `left_out` names: every
-    /// triangle that can stop such a segment. `None` where there are more than `most` (at most eight), or the walk
-    /// would look at more than `budget` nodes and leaves.
+    /// triangle that can stop such a segment. `None` where there are more than `most` (at most eight), more than
+    /// sixteen before clipping, or the walk would look at more than `budget` nodes and leaves.
     pub fn shaft_blockers(
         &self,
         shaft: &Shaft,
@@ -147,8 +147,11 @@ impl Accel {
         budget: u32,
         most: usize,
     ) -> Option<ArrayVec<u32, 8>> {
-        let mut found = ArrayVec::new();
-        let Some(root) = self.root else { return Some(found) };
+        // The triangles no face or front clears at once, clipped once the walk is over: a shaft through a dense
+        // mesh gives up on its seventeenth, where clipping each as it came cost the knot's tiles more than their
+        // shadow rays saved.
+        let mut open_ones = ArrayVec::<(u32, [Vec3; 3]), 16>::new();
+        let Some(root) = self.root else { return Some(ArrayVec::new()) };
         let mut stack = ArrayVec::<Child, STACK>::new();
         stack.push(root);
         let mut visits = 0;
@@ -163,11 +166,8 @@ impl Accel {
                     while open != 0 {
                         let lane = open.trailing_zeros() as usize;
                         let id = packet.ids[lane];
-                        if !left_out(id) && !packet.vertices(lane).is_some_and(|v| shaft.clears(v)) {
-                            if found.len() == most.min(8) {
-                                return None;
-                            }
-                            found.push(id);
+                        if let (false, Some(v)) = (left_out(id), packet.vertices(lane)) {
+                            open_ones.try_push((id, v)).ok()?;
                         }
                         open &= open - 1;
                     }
@@ -179,6 +179,12 @@ impl Accel {
                     stack.push(node.children[mask.trailing_zeros() as usize]);
                     mask &= mask - 1;
                 }
+            }
+        }
+        let mut found = ArrayVec::new();
+        for (id, v) in open_ones {
+            if !shaft.clears(v) {
+                found.try_push(id).ok().filter(|()| found.len() <= most)?;
             }
         }
         Some(found)
