@@ -7,7 +7,7 @@ mod common;
 use common::{any_camera, estimate_with, on_surface, quad};
 use glam::Vec3;
 use illumlab::render::{Film, Heuristic, MisSettings, RenderSettings, Renderer, Strategy};
-use illumlab::scene::{Camera, LightSelection, Material, Scene};
+use illumlab::scene::{Camera, LightSelection, Material, Scene, TileLights};
 
 const ALPHAS: [f32; 5] = [0.0, 1e-3, 1.0, 1e3, 1e6];
 
@@ -168,7 +168,8 @@ fn the_probe_is_finite_at_the_extremes() {
     let scene = scene(any_camera());
     let emitters = EmitterSampler::new(&scene, LightSelection::Power);
     let mis = MisSettings::default();
-    let ctx = SampleContext { scene: &scene, emitters: emitters.as_ref(), mis: &mis, state: None, guide: None };
+    let tile = &TileLights::NONE;
+    let ctx = SampleContext { scene: &scene, emitters: emitters.as_ref(), mis: &mis, state: None, guide: None, tile };
     let view = Vec3::new(0.2, 0.9, 0.1).normalize();
     let points = [
         (Vec3::new(0.1, 0.0, 0.0), Vec3::Y, Vec3::new(1.0, 1e-6, 0.3).normalize()),

@@ -15,7 +15,7 @@ use illumlab::math::{SampleRng, lambert_polygon_irradiance};
 use illumlab::probe::chi2::{p_value, pearson};
 use illumlab::probe::{Probe, ProbeRun, density};
 use illumlab::render::{Film, MisSettings, RenderSettings, Renderer, SampleContext, ShadingPoint, Strategy};
-use illumlab::scene::{Camera, EmitterSampler, LightSelection, Scene, load_scene};
+use illumlab::scene::{Camera, EmitterSampler, LightSelection, Scene, TileLights, load_scene};
 use std::f32::consts::PI;
 use std::sync::Arc;
 
@@ -154,7 +154,7 @@ fn trained_guide(scene: &Scene) -> Arc<Guide> {
 fn context<'a>(scene: &'a Scene, emitters: Option<&'a EmitterSampler>, guide: &'a Guide) -> SampleContext<'a> {
     static MIS: std::sync::OnceLock<MisSettings> = std::sync::OnceLock::new();
     let mis = MIS.get_or_init(MisSettings::default);
-    SampleContext { scene, emitters, mis, state: None, guide: Some(guide) }
+    SampleContext { scene, emitters, mis, state: None, guide: Some(guide), tile: &TileLights::NONE }
 }
 
 /// The whole mixture (guide + emitter + BRDF) at a frozen guide, binned on the sphere about +z: a synthetic guide

@@ -22,7 +22,7 @@ use crate::guiding::Guide;
 use crate::math::luminance;
 use crate::render::strategy::StrategyState;
 use crate::render::{RenderSettings, SampleContext, Strategy};
-use crate::scene::{EmitterSampler, Scene};
+use crate::scene::{EmitterSampler, Scene, TileLights};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -106,7 +106,8 @@ impl Probe {
     pub fn context(&self) -> SampleContext<'_> {
         let state = self.state.as_deref();
         let guide = self.guide.as_deref();
-        SampleContext { scene: &self.scene, emitters: self.emitters.as_ref(), mis: &self.settings.mis, state, guide }
+        let (scene, emitters, mis, tile) = (&self.scene, self.emitters.as_ref(), &self.settings.mis, &TileLights::NONE);
+        SampleContext { scene, emitters, mis, state, guide, tile }
     }
 
     /// The point under pixel (x, y) of the scene's camera.

@@ -5,7 +5,7 @@ use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
 use crate::math::{SampleRng, SurfaceError, Vec3x8, offset_ray_origin, offset_ray_origins};
-use crate::scene::{EmitterSampler, SKIP_NONE, Scene, ShadowBlockers};
+use crate::scene::{EmitterSampler, SKIP_NONE, Scene, ShadowBlockers, TileLights};
 use glam::Vec3;
 use wide::{CmpGt, f32x8, i32x8};
 
@@ -23,7 +23,8 @@ pub fn estimate_direct(
     rays: &mut u64,
 ) -> Vec3 {
     let state = settings.strategy.prepare(scene, settings);
-    let ctx = SampleContext { scene, emitters, mis: &settings.mis, state: state.as_deref(), guide: None };
+    let (state, tile) = (state.as_deref(), &TileLights::NONE);
+    let ctx = SampleContext { scene, emitters, mis: &settings.mis, state, guide: None, tile };
     settings.strategy.estimate(&ctx, sp, rng, rays, &mut ())
 }
 

@@ -174,7 +174,8 @@ mod tests {
         ];
         let scene = load_scene("cornell-box").expect("bundled scene");
         let mis = MisSettings::default();
-        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: None, guide: None };
+        let tile = &crate::scene::TileLights::NONE;
+        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: None, guide: None, tile };
         let mut setup = SampleRng::new(11, 0, 0);
         let mut unit = || {
             let w = crate::sampling::sample_uniform_hemisphere(setup.uniform_2d());

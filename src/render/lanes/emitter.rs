@@ -285,7 +285,7 @@ pub fn estimate_emitter_lanes(
 #[inline(never)]
 pub fn estimate_mis_emitter_brdf_lanes(
     ctx: &SampleContext,
-    lights: (&EmitterSampler, &TileLights),
+    emitters: &EmitterSampler,
     dirs: &Vec3x8,
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
@@ -295,7 +295,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
     let heuristic = ctx.mis.heuristic;
     let before = *rngs;
-    let e = EmitterLanes::draw(scene, lights, dirs, hits, rngs);
+    let e = EmitterLanes::draw(scene, (emitters, ctx.tile), dirs, hits, rngs);
     // Each lane's L_e towards the camera, and its light direction's contribution, weighted (if its shadow ray
     // gets through), as `unshadowed` gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
     // Where the material is diffuse (k_s = 0) in f32x8: f_r = k_d/π where n·ω > 0 (in `ok`) and n·ω_o > 0, and
@@ -344,7 +344,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let mut streams = rngs.with_lanes_after(&before, !(e.picked & e.faces), 1);
     let near = (e.p, e.n, e.wo, e.p_error);
     let from_brdf = mis_brdf_technique(&contexts, &Emitter, &materials, near, &mut streams, rays);
-    let visible = e.visible(scene, lights.1, shadow_rays, rays);
+    let visible = e.visible(scene, ctx.tile, shadow_rays, rays);
     mis_sums(&emitted, &first, shadow_rays & !visible, &from_brdf)
 }
 
@@ -365,8 +365,14 @@ mod tests {
         for (name, scene, camera) in every_bundled_scene(24, 18) {
             for selection in LightSelection::ALL {
                 let Some(emitters) = EmitterSampler::new(&scene, selection) else { continue };
-                let ctx =
-                    SampleContext { scene: &scene, emitters: Some(&emitters), mis: &mis, state: None, guide: None };
+                let ctx = SampleContext {
+                    scene: &scene,
+                    emitters: Some(&emitters),
+                    mis: &mis,
+                    state: None,
+                    guide: None,
+                    tile: &TileLights::NONE,
+                };
                 let basis = camera.basis();
                 for (pixel, (x, y)) in
                     (0..camera.height).flat_map(|y| (0..camera.width).map(move |x| (x, y))).enumerate()
@@ -381,14 +387,8 @@ mod tests {
                     }));
                     let (mut simd_rays, mut lane_rays) = (0, 0);
                     let mut lane_rngs = std::array::from_fn(|l| rngs.lane(l));
-                    let simd = estimate_mis_emitter_brdf_lanes(
-                        &ctx,
-                        (&emitters, &TileLights::NONE),
-                        &dirs,
-                        &hits,
-                        &mut rngs,
-                        &mut simd_rays,
-                    );
+                    let simd =
+                        estimate_mis_emitter_brdf_lanes(&ctx, &emitters, &dirs, &hits, &mut rngs, &mut simd_rays);
                     let by_lane =
                         estimate_mis_lanes(&ctx, (&Emitter, &Brdf), &dirs, &hits, &mut lane_rngs, &mut lane_rays);
                     for l in 0..n {

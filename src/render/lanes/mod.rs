@@ -20,10 +20,10 @@ use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, offset_ray_origins};
-use crate::scene::{Hit, HitLanes, Material, SKIP_NONE, Scene};
+use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lanes_in, offset_ray_origins};
+use crate::scene::{Hit, HitLanes, Material, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
-use wide::f32x8;
+use wide::{f32x8, i32x8};
 
 /// Samples per group.
 pub const LANES: usize = 8;
@@ -51,7 +51,7 @@ pub fn estimate_one_sample_lanes(
             lanes.add(l, ctx.scene, &sp, s, rays);
         }
     }
-    lanes.finish(ctx.scene, rays)
+    lanes.finish(ctx, rays)
 }
 
 /// The one-sample estimator's lanes as their directions are added: the radiance each camera ray sees emitted,
@@ -82,9 +82,9 @@ impl OneSampleLanes {
 
     /// Traces the rays together; each lane's estimate.
     #[inline(always)]
-    pub fn finish(mut self, scene: &Scene, rays: &mut u64) -> [Vec3; LANES] {
-        let visible = self.shadow_rays.trace(scene, rays);
-        for (l, found) in self.traced.trace(scene, rays).into_iter().enumerate() {
+    pub fn finish(mut self, ctx: &SampleContext, rays: &mut u64) -> [Vec3; LANES] {
+        let visible = self.shadow_rays.trace(ctx.scene, ctx.tile, rays);
+        for (l, found) in self.traced.trace(ctx.scene, ctx.tile, rays).into_iter().enumerate() {
             if let Ok((value, _, s)) = found {
                 self.reflected[l] = value / s.pdf;
             }
@@ -117,14 +117,16 @@ struct ShadowRays {
     p_error: [f32; LANES],
     light_error: [SurfaceError; LANES],
     groups: [u32; LANES],
+    /// Per lane: the emitter triangle the ray ends on.
+    lights: [u32; LANES],
     /// The lanes with a ray.
     lanes: u32,
 }
 
 impl Default for ShadowRays {
     fn default() -> Self {
-        let (p_error, light_error) = ([0.0; LANES], [SurfaceError::default(); LANES]);
-        Self { ends: [[Vec3::ZERO; LANES]; 4], p_error, light_error, groups: [SKIP_NONE; LANES], lanes: 0 }
+        let (p_error, light_error, groups) = ([0.0; LANES], [SurfaceError::default(); LANES], [SKIP_NONE; LANES]);
+        Self { ends: [[Vec3::ZERO; LANES]; 4], p_error, light_error, groups, lights: [u32::MAX; LANES], lanes: 0 }
     }
 }
 
@@ -141,6 +143,7 @@ impl ShadowRays {
         (self.ends[0][l], self.ends[1][l], self.ends[2][l], self.ends[3][l]) = (p, n, point, n_x);
         (self.p_error[l], self.light_error[l]) = (error, scene.triangles[triangle as usize].error);
         self.groups[l] = scene.convex_group(triangle).unwrap_or(SKIP_NONE);
+        self.lights[l] = triangle;
         self.lanes |= 1 << l;
     }
 
@@ -150,15 +153,26 @@ impl ShadowRays {
         self.add_from(l, scene, near, (via.triangle, via.point, scene.triangles[via.triangle as usize].n));
     }
 
-    /// The lanes whose ray gets through; adds the rays traced to `rays`.
+    /// The lanes whose ray gets through; adds the rays to `rays` (those to one of `tile`'s clear lights are
+    /// answered without being traced, those to a light its blockers list meet only them).
     #[inline(always)]
-    fn trace(&self, scene: &Scene, rays: &mut u64) -> u32 {
+    fn trace(&self, scene: &Scene, tile: &TileLights, rays: &mut u64) -> u32 {
         if self.lanes == 0 {
             return 0; // no lane has a ray (most groups' BRDF directions miss the lights)
         }
         let [p, n, x, n_x] = self.ends.map(|e| Vec3x8::from_lanes(&e));
         let near = (p, n, f32x8::new(self.p_error));
-        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, None, rays)
+        let far = (&self.light_error, self.groups);
+        if tile.clear == 0 && tile.blockers.is_none() {
+            return visible_lanes(scene, near, (x, n_x), far, self.lanes, None, rays);
+        }
+        // Each lane's emitter slot: a tile knows something only in a scene of a few emitter triangles.
+        let slot = |t: u32| scene.emitters.iter().position(|&e| e == t).map_or(-1, |s| s as i32);
+        let slots = i32x8::new(self.lights.map(slot));
+        let clear = lanes_in(tile.clear, slots) & self.lanes;
+        *rays += clear.count_ones() as u64;
+        let blockers = tile.blockers.as_deref().map(|b| (b, slots));
+        clear | visible_lanes(scene, near, (x, n_x), far, self.lanes & !clear, blockers, rays)
     }
 }
 
@@ -210,7 +224,7 @@ pub fn estimate_mis_lanes(
     }
     // The BRDF directions, each drawn after its lane's light direction.
     let from_brdf = mis_second_technique(&contexts, (light, brdf), &shading, rngs, rays);
-    let visible = shadow_rays.trace(scene, rays);
+    let visible = shadow_rays.trace(scene, ctx.tile, rays);
     mis_sums(&emitted, &first, shadow_rays.lanes & !visible, &from_brdf)
 }
 
@@ -238,7 +252,7 @@ fn mis_second_technique(
             weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
         }
     }
-    for (l, found) in traced.trace(scene, rays).into_iter().enumerate() {
+    for (l, found) in traced.trace(scene, contexts[1].tile, rays).into_iter().enumerate() {
         let (Some(sp), Ok((value, via, s))) = (&shading[l], found) else { continue };
         weighted[l] = weighted_second(contexts, light, sp, value, via, &s);
     }
@@ -277,7 +291,7 @@ fn mis_brdf_technique(
         shadow_rays.add_to_reached(l, scene, (sp.p, sp.n, sp.error), via);
         weighted[l] = weighted_second(contexts, light, &sp, value, via, &s);
     });
-    let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
+    let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, contexts[1].tile, rays);
     for_each_lane(blocked, |l| weighted[l] = Vec3::ZERO);
     weighted
 }
@@ -352,6 +366,7 @@ impl TracedRays {
     fn trace(
         &self,
         scene: &Scene,
+        tile: &TileLights,
         rays: &mut u64,
     ) -> [Result<(Vec3, super::strategy::Reached, DirectionSample), Outcome>; LANES] {
         let found = scene.emitter_tree().closest_hits(&self.rays, self.lanes);
@@ -363,7 +378,7 @@ impl TracedRays {
             shadow_rays.add_to_reached(l, scene, near, via);
             lit[l] = Ok((value, via, s));
         });
-        let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, rays);
+        let blocked = shadow_rays.lanes & !shadow_rays.trace(scene, tile, rays);
         for_each_lane(blocked, |l| lit[l] = Err(Outcome::Occluded));
         lit
     }
@@ -409,8 +424,8 @@ pub fn estimate_guided_lanes(
         };
         drawn[l] = Some((sp, d, known));
     }
-    let visible = shadow_rays.trace(scene, rays);
-    let found = traced.trace(scene, rays);
+    let visible = shadow_rays.trace(scene, ctx.tile, rays);
+    let found = traced.trace(scene, ctx.tile, rays);
     for (l, lane) in drawn.iter().enumerate() {
         let Some((sp, d, known)) = lane else { continue };
         let result = match *known {

@@ -61,5 +61,5 @@ pub fn estimate_projected_solid_angle_lanes(
             }
         }
     }
-    lanes.finish(scene, rays)
+    lanes.finish(ctx, rays)
 }

@@ -52,5 +52,5 @@ pub fn estimate_solid_angle_lanes(
             }
         });
     }
-    lanes.finish(scene, rays)
+    lanes.finish(ctx, rays)
 }

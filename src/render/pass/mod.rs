@@ -130,6 +130,7 @@ impl Renderer {
             mis: &self.settings.mis,
             state: self.state.as_deref(),
             guide: self.guide().map(|g| &**g),
+            tile: &TileLights::NONE,
         }
     }
 
@@ -375,7 +376,7 @@ impl Renderer {
             }
             (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                let ctx = self.context();
+                let ctx = SampleContext { tile, ..self.context() };
                 // The bundled light strategies' own code, inlined; any other through the registry.
                 match strategy {
                     Strategy::SolidAngle => estimate_solid_angle_lanes(&ctx, &dirs, &hits, &mut rngs, rays),
@@ -388,13 +389,13 @@ impl Renderer {
             // The hemisphere strategies: their rays walk the tree together.
             (Strategy::Uniform | Strategy::Cosine | Strategy::Brdf, _) if learned.is_none() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                let ctx = self.context();
+                let ctx = SampleContext { tile, ..self.context() };
                 estimate_one_sample_lanes(&ctx, &strategy, &dirs, &hits, &mut rngs, rays)
             }
             // `guided`, frozen or learning (a learning pass records every direction at its point's leaf).
             (Strategy::Guided, _) => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                let ctx = self.context();
+                let ctx = SampleContext { tile, ..self.context() };
                 match (learned, ctx.guide) {
                     (Some(out), Some(guide)) => {
                         let mut home = None;
@@ -414,15 +415,15 @@ impl Renderer {
                     && self.settings.mis.samples == [1, 1]
                     && self.settings.mis.techniques == [Strategy::Emitter, Strategy::Brdf] =>
             {
-                let lights = (emitters, tile);
-                estimate_mis_emitter_brdf_lanes(&self.context(), lights, &dirs, &hits, &mut rngs, rays)
+                let ctx = SampleContext { tile, ..self.context() };
+                estimate_mis_emitter_brdf_lanes(&ctx, emitters, &dirs, &hits, &mut rngs, rays)
             }
             // MIS with one direction per technique, learning nothing: the light directions' shadow rays together.
             (Strategy::Mis, _)
                 if learned.is_none() && self.settings.mis.is_valid() && self.settings.mis.samples == [1, 1] =>
             {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
-                let ctx = self.context();
+                let ctx = SampleContext { tile, ..self.context() };
                 let lanes = (&dirs, &hits, &mut rngs, rays);
                 // The usual pairs with their techniques' code inlined, as MIS's own estimator has them.
                 match self.settings.mis.techniques {

@@ -247,7 +247,8 @@ mod tests {
         let scene = crate::scene::load_scene("cornell-box").expect("bundled");
         let states = TechniqueStates([Some(Arc::new(7u32) as StrategyState), None]);
         let mis = MisSettings::default();
-        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: Some(&states), guide: None };
+        let tile = &crate::scene::TileLights::NONE;
+        let ctx = SampleContext { scene: &scene, emitters: None, mis: &mis, state: Some(&states), guide: None, tile };
         assert_eq!(technique_context(&ctx, 0).state::<u32>(), Some(&7));
         assert!(technique_context(&ctx, 1).state.is_none());
         // No registered technique has state yet, so MIS prepares none.

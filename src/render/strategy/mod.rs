@@ -29,7 +29,7 @@ use super::sink::SampleSink;
 use super::{RenderSettings, ShadingPoint};
 use crate::guiding::Guide;
 use crate::math::SampleRng;
-use crate::scene::{EmitterSampler, Scene};
+use crate::scene::{EmitterSampler, Scene, TileLights};
 use glam::Vec3;
 use std::any::Any;
 use std::sync::Arc;
@@ -52,6 +52,10 @@ pub struct SampleContext<'a> {
     /// The guide the renderer is learning or has learned (`guided`, alone or as a technique of MIS); it changes
     /// only between passes.
     pub guide: Option<&'a Guide>,
+    /// What the renderer knows of the shadow rays from the pixel being shaded (its tile's clear lights and
+    /// blockers), which the eight-lane estimators use to answer them; [`TileLights::NONE`] elsewhere. Every
+    /// answer is the one tracing gives.
+    pub tile: &'a TileLights,
 }
 
 impl<'a> SampleContext<'a> {
