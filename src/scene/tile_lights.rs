@@ -57,8 +57,8 @@ impl Scene {
         for (slot, &light) in self.emitters.iter().enumerate() {
             let mut found = ArrayVec::<u32, 8>::new();
             let shafts = footprints.iter().map(|f| self.light_blockers(eye, f, own_error, light, candidates));
-            let all = shafts.into_iter().try_for_each(|blockers| {
-                for t in blockers? {
+            let all = shafts.into_iter().try_for_each(|in_shaft| {
+                for t in in_shaft? {
                     if !found.contains(&t) {
                         found.try_push(t).ok()?;
                     }
@@ -74,7 +74,7 @@ impl Scene {
             }
             let new = found.iter().filter(|&&t| !blockers.iter().any(|b| b.0 == t)).count();
             if blockers.len() + new > 8 {
-                continue;
+                continue; // these too
             }
             for t in found {
                 match blockers.iter_mut().find(|b| b.0 == t) {
@@ -150,7 +150,7 @@ impl Scene {
                 || (candidates.len() == 1 && t == candidates[0])
                 || (group.is_some() && self.convex_group(t) == group)
         };
-        self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET, 8)
+        self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET)
     }
 }
 

@@ -138,14 +138,13 @@ impl TrianglePacket {
 
 impl Accel {
     /// The ids of the triangles that may meet a segment in `shaft`, but for those `left_out` names: every
-    /// triangle that can stop such a segment. `None` where there are more than `most` (at most eight), more than
-    /// sixteen before clipping, or the walk would look at more than `budget` nodes and leaves.
+    /// triangle that can stop such a segment. `None` where there are more than eight (more than sixteen before
+    /// clipping), or the walk would look at more than `budget` nodes and leaves.
     pub fn shaft_blockers(
         &self,
         shaft: &Shaft,
         left_out: impl Fn(u32) -> bool,
         budget: u32,
-        most: usize,
     ) -> Option<ArrayVec<u32, 8>> {
         // The triangles no face or front clears at once, clipped once the walk is over: a shaft through a dense
         // mesh gives up on its seventeenth, where clipping each as it came cost the knot's tiles more than their
@@ -184,7 +183,7 @@ impl Accel {
         let mut found = ArrayVec::new();
         for (id, v) in open_ones {
             if !shaft.clears(v) {
-                found.try_push(id).ok().filter(|()| found.len() <= most)?;
+                found.try_push(id).ok()?;
             }
         }
         Some(found)
