@@ -4,8 +4,8 @@
 use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
-use crate::math::{SampleRng, SurfaceError, Vec3x8, offset_ray_origin, offset_ray_origins};
-use crate::scene::{EmitterSampler, SKIP_NONE, Scene, ShadowBlockers, TileLights};
+use crate::math::{SampleRng, SurfaceError, Vec3x8, lanes_in, offset_ray_origin, offset_ray_origins};
+use crate::scene::{EmitterSampler, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
 use wide::{CmpGt, f32x8, i32x8};
 
@@ -177,8 +177,9 @@ pub(super) fn shadow_ray_ends_lanes(
 /// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i): the
 /// shading points (p, n, their bounds), the points x on the lights with their normals, lane i's x on a triangle
 /// with bounds `far[i]` of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible ones.
-/// With `blockers` (the tile's, and each lane's emitter slot), the lanes whose slot it lists meet its triangles
-/// alone; the others walk the tree. Lane i's answer is `visible`'s, bit for bit.
+/// With `tile` (the pixel's tile, and each lane's emitter slot), the rays to its clear lights get through untraced
+/// and those to a light its blockers list meet them alone; the others walk the tree. Lane i's answer is
+/// `visible`'s, bit for bit.
 #[inline]
 pub(super) fn visible_lanes(
     scene: &Scene,
@@ -186,18 +187,19 @@ pub(super) fn visible_lanes(
     (x, n_x): (Vec3x8, Vec3x8),
     (far, groups): (&[SurfaceError; 8], [u32; 8]),
     active: u32,
-    blockers: Option<(&ShadowBlockers, i32x8)>,
+    tile: Option<(&TileLights, i32x8)>,
     rays: &mut u64,
 ) -> u32 {
-    if active == 0 {
-        return 0; // a group whose samples all missed, saw only a light, or were rejected
-    }
     *rays += active.count_ones() as u64;
+    let clear = tile.map_or(0, |(tile, slots)| lanes_in(tile.clear, slots)) & active;
+    let traced = active & !clear;
+    if traced == 0 {
+        return active; // no ray (all missed, saw only a light, or were rejected), or only rays to clear lights
+    }
     let (from, to) = shadow_ray_ends_lanes(near, (x, n_x), far);
-    let mut occluded = 0;
-    let mut walking = active;
-    if let Some((blockers, slots)) = blockers {
-        let listed = active & blockers.listed(slots);
+    let (mut occluded, mut walking) = (0, traced);
+    if let Some((blockers, slots)) = tile.and_then(|(tile, slots)| Some((tile.blockers.as_deref()?, slots))) {
+        let listed = traced & blockers.listed(slots);
         occluded = blockers.occluded_lanes(&from, &(to - from), SEGMENT_END, listed, slots);
         walking &= !listed;
     }

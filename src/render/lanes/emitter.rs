@@ -6,7 +6,7 @@
 //! bit.
 
 use super::{LANES, mis_brdf_technique, mis_sums};
-use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask, lanes_in};
+use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
@@ -47,9 +47,6 @@ struct EmitterLanes {
     cos: [f32; LANES],
     /// Each lane's emitter slot (meaningful in the lanes of `picked`).
     slots: i32x8,
-    /// The lanes whose picked light is one of the tile's clear lights (`TileLights::clear`): their shadow rays
-    /// get through, found without tracing them.
-    clear: u32,
     /// The lanes whose direction is a sample that can contribute: on the emitting side, at a positive finite
     /// density, above the surface.
     ok: u32,
@@ -57,11 +54,11 @@ struct EmitterLanes {
 
 impl EmitterLanes {
     /// Draws each lane's direction: the light's uniform, then the point's two, from lane l of `rngs` (every lane
-    /// draws all three, used or not). `tile` says which of the pixel's shadow rays are clear.
+    /// draws all three, used or not).
     #[inline(always)]
     fn draw(
         scene: &Scene,
-        (emitters, tile): (&EmitterSampler, &TileLights),
+        emitters: &EmitterSampler,
         dirs: &Vec3x8,
         hits: &HitLanes,
         rngs: &mut SampleRngLanes,
@@ -142,7 +139,6 @@ impl EmitterLanes {
                 let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
                 (i32x8::new(slots), Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
             };
-        let clear = lanes_in(tile.clear, slots) & picked;
         let ln = Vec3x8::new(nx, ny, nz);
         // The picked triangle's material (u32::MAX for none) and convex emitter group.
         let light_material = material.to_array().map(f32::to_bits);
@@ -185,7 +181,6 @@ impl EmitterLanes {
             wi,
             pdf: pdf.to_array(),
             cos: cos.to_array(),
-            clear,
             ok: ok.move_mask() as u32,
         }
     }
@@ -206,10 +201,7 @@ impl EmitterLanes {
     fn visible(&self, scene: &Scene, tile: &TileLights, active: u32, rays: &mut u64) -> u32 {
         let (near, far, lights) =
             ((self.p, self.n, self.p_error), (self.x, self.ln), (&self.light_error, self.light_group));
-        let clear = active & self.clear;
-        *rays += clear.count_ones() as u64;
-        let blockers = tile.blockers.as_deref().map(|b| (b, self.slots));
-        clear | visible_lanes(scene, near, far, lights, active & !clear, blockers, rays)
+        visible_lanes(scene, near, far, lights, active, Some((tile, self.slots)), rays)
     }
 }
 
@@ -225,7 +217,7 @@ pub fn estimate_emitter_lanes(
     rngs: &mut SampleRngLanes,
     rays: &mut u64,
 ) -> [Vec3; LANES] {
-    let e = EmitterLanes::draw(scene, lights, dirs, hits, rngs);
+    let e = EmitterLanes::draw(scene, lights.0, dirs, hits, rngs);
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
     for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
@@ -295,7 +287,7 @@ pub fn estimate_mis_emitter_brdf_lanes(
     let contexts = [technique_context(ctx, 0), technique_context(ctx, 1)];
     let heuristic = ctx.mis.heuristic;
     let before = *rngs;
-    let e = EmitterLanes::draw(scene, (emitters, ctx.tile), dirs, hits, rngs);
+    let e = EmitterLanes::draw(scene, emitters, dirs, hits, rngs);
     // Each lane's L_e towards the camera, and its light direction's contribution, weighted (if its shadow ray
     // gets through), as `unshadowed` gives it: `f_r L_e (ω·n)`, with a shadow ray wherever f_r ≠ 0 and L_e ≠ 0.
     // Where the material is diffuse (k_s = 0) in f32x8: f_r = k_d/π where n·ω > 0 (in `ok`) and n·ω_o > 0, and

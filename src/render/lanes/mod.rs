@@ -20,7 +20,7 @@ use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lanes_in, offset_ray_origins};
+use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, offset_ray_origins};
 use crate::scene::{Hit, HitLanes, Material, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
 use wide::{f32x8, i32x8};
@@ -162,17 +162,11 @@ impl ShadowRays {
         }
         let [p, n, x, n_x] = self.ends.map(|e| Vec3x8::from_lanes(&e));
         let near = (p, n, f32x8::new(self.p_error));
-        let far = (&self.light_error, self.groups);
-        if tile.clear == 0 && tile.blockers.is_none() {
-            return visible_lanes(scene, near, (x, n_x), far, self.lanes, None, rays);
-        }
-        // Each lane's emitter slot: a tile knows something only in a scene of a few emitter triangles.
+        // Each lane's emitter slot, where the tile knows something (only in a scene of a few emitter triangles).
         let slot = |t: u32| scene.emitters.iter().position(|&e| e == t).map_or(-1, |s| s as i32);
-        let slots = i32x8::new(self.lights.map(slot));
-        let clear = lanes_in(tile.clear, slots) & self.lanes;
-        *rays += clear.count_ones() as u64;
-        let blockers = tile.blockers.as_deref().map(|b| (b, slots));
-        clear | visible_lanes(scene, near, (x, n_x), far, self.lanes & !clear, blockers, rays)
+        let known = tile.clear != 0 || tile.blockers.is_some();
+        let tile = known.then(|| (tile, i32x8::new(self.lights.map(slot))));
+        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, tile, rays)
     }
 }
 
