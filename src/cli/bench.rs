@@ -10,7 +10,7 @@ use illumlab::measure::{
     sees_emitter, write_convergence_png, write_csv,
 };
 use illumlab::render::{Film, Footprint, RenderSettings, Renderer, Strategy, check_output_path};
-use illumlab::scene::{LightSelection, Scene, vector_path};
+use illumlab::scene::{LightSelection, Scene};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -140,7 +140,7 @@ pub fn bench(args: BenchArgs) -> Result<()> {
         width: w,
         height: h,
         reference: &reference_line,
-        machine: &format!("{machine} ({threads} used; shadow rays in {})", vector_path().name()),
+        machine: &format!("{machine} ({threads} used; shadow rays in {})", scene.accel().shadow_walk()),
         footprint: args.footprint,
     };
     let md = markdown(&report, &ctx);

@@ -11,7 +11,7 @@ use illumlab::render::{
     Film, Footprint, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
     write_image,
 };
-use illumlab::scene::{LightSelection, Scene, load_scene, vector_path};
+use illumlab::scene::{LightSelection, Scene, load_scene};
 use illumlab::session::views::View;
 use illumlab::session::worker::Budget;
 use std::path::PathBuf;
@@ -314,6 +314,7 @@ fn render(args: RenderArgs) -> Result<()> {
         guiding: args.guiding.settings(),
     };
     let mut film = Film::new(scene.camera.width, scene.camera.height);
+    let shadow_walk = scene.accel().shadow_walk();
     let mut renderer = Renderer::new(std::sync::Arc::new(scene), settings);
 
     // Passes of a few samples each: the progress bar advances between them; the result does not depend on it.
@@ -352,7 +353,7 @@ fn render(args: RenderArgs) -> Result<()> {
         stats.samples as f64 / seconds / 1e6,
         stats.rays as f64 / seconds / 1e6,
         stats.non_finite,
-        vector_path().name(),
+        shadow_walk,
         args.output.display()
     );
     Ok(())

@@ -41,6 +41,8 @@ pub(super) struct Built {
     pub groups: Vec<ChildGroups>,
     pub packets: Vec<TrianglePacket>,
     pub root: Child,
+    /// The wide levels on the longest path from the root to a leaf (0 when the root is a leaf).
+    pub depth: usize,
     /// `order[i]` = input index of the i-th stored triangle; packets refer to stored indices.
     pub order: Vec<u32>,
 }
@@ -62,10 +64,11 @@ pub(super) fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> Built {
         child_groups: Vec::with_capacity(wide),
         packets: Vec::with_capacity(positions.len() / 4 + 1),
         order: Vec::with_capacity(positions.len()),
+        depth: 0,
     };
     let (root, _) = builder.child(0, 0);
     let (nodes, groups, packets, order) = (builder.nodes, builder.child_groups, builder.packets, builder.order);
-    Built { nodes, groups, packets, root, order }
+    Built { nodes, groups, packets, root, depth: builder.depth, order }
 }
 
 /// obvhs's binary tree over the triangles, and the leaves the SAH chooses in it (with the traversal cost of
@@ -118,6 +121,8 @@ struct Builder<'a> {
     child_groups: Vec<ChildGroups>,
     packets: Vec<TrianglePacket>,
     order: Vec<u32>,
+    /// The deepest wide level made so far.
+    depth: usize,
 }
 
 impl Builder<'_> {
@@ -138,6 +143,7 @@ impl Builder<'_> {
             let first = self.bvh.nodes[node].first_index as usize;
             open.extend([first, first + 1]);
         }
+        self.depth = self.depth.max(depth + 1);
         let slot = self.nodes.len();
         self.nodes.push(Node8::new(&[]));
         self.child_groups.push(ChildGroups::new(&[]));
