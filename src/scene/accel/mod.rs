@@ -269,6 +269,10 @@ mod tests {
         for (n, size) in [(1, 4.0), (7, 3.0), (8, 3.0), (9, 3.0), (100, 2.0), (3000, 0.8)] {
             check_against_brute_force(&random_soup(n, size, n as u64), 4000);
         }
+        // A tree deeper than the shared walk pays in, whose any-hit walks push a node's children in one step.
+        let deep = random_soup(40_000, 0.25, 40_000);
+        assert!(Accel::build(&deep, &groups_by_side(&deep)).0.depth > shadow_bundle::SHARED_WALK_DEPTH);
+        check_against_brute_force(&deep, 300);
     }
 
     /// Eight rays walking the BVH together, one per lane, answer as each does alone, bit for bit: bundles from

@@ -24,14 +24,9 @@ pub(super) const SET_ASIDE: usize = 8;
 /// that is at the leaves, and walking together pays: alone from the root, `occluded-light`'s `emitter` took 0.63 s
 /// instead of 0.39 s and the Cornell box's 0.29 s instead of 0.26 s. In the knot's tree (seven levels, 67 200
 /// triangles) they part a few levels down: the shared walk tested boxes for 3.5 rays on average, through about ten
-/// nodes a bundle, and walking alone from the root (with [`AnyHitStack::push_entered`]) made the knot's whole
+/// nodes a bundle, and walking alone from the root (with `traverse::push_entered`) made the knot's whole
 /// `emitter` render 18% faster, 0.82 s → 0.67 s (256², 256 spp, AMD EPYC Zen 4, 2026-12-06).
 pub(super) const SHARED_WALK_DEPTH: usize = 4;
-
-thread_local! {
-    /// Each thread's eight any-hit stacks for [`Accel::occluded_lanes`]: made once, since a stack is a kilobyte.
-    static ALONE: std::cell::RefCell<Box<[AnyHitStack; 8]>> = std::cell::RefCell::new(Box::default());
-}
 
 impl Accel {
     /// How [`Accel::occluded_lanes`]'s rays walk this tree, for `render`, `bench` and the status bar: together, in
@@ -74,22 +69,19 @@ impl Accel {
     ) -> u32 {
         let Some(root) = self.root else { return 0 };
         let skips = skips.map(|s| s as i32);
-        ALONE.with_borrow_mut(|alone| {
-            // A shared walk that ends early (every ray occluded) leaves subtrees set aside.
-            alone.iter_mut().for_each(AnyHitStack::clear);
-            if active.count_ones() < path.packet_min_rays() || self.depth > SHARED_WALK_DEPTH {
-                for_each_lane(active, |l| alone[l].push(root));
-                return self.walk_alone(alone, active, origins, dirs, t_max, &skips);
-            }
-            let rays = RayLanes::new(origins, dirs);
-            #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
-            if path == VectorPath::Avx512 {
-                let walk = |tests: &_| self.walk_shared(root, active, tests, t_max, &skips, alone, origins, dirs);
-                return avx512::occluded_lanes(walk, &rays);
-            }
-            let _ = path; // one path only in builds without the 16-lane code
-            self.walk_shared(root, active, &rays, t_max, &skips, alone, origins, dirs)
-        })
+        let mut alone: [AnyHitStack; 8] = Default::default();
+        if active.count_ones() < path.packet_min_rays() || self.depth > SHARED_WALK_DEPTH {
+            for_each_lane(active, |l| alone[l].push(root));
+            return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
+        }
+        let rays = RayLanes::new(origins, dirs);
+        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+        if path == VectorPath::Avx512 {
+            let walk = |tests: &_| self.walk_shared(root, active, tests, t_max, &skips, &mut alone, origins, dirs);
+            return avx512::occluded_lanes(walk, &rays);
+        }
+        let _ = path; // one path only in builds without the 16-lane code
+        self.walk_shared(root, active, &rays, t_max, &skips, &mut alone, origins, dirs)
     }
 
     /// The shared walk of [`Accel::occluded_lanes`], its nodes and leaves tested by `tests`.
