@@ -1,7 +1,8 @@
 //! Eight any-hit rays walking the BVH together, one per lane (e.g. the shadow rays of eight samples of one
 //! pixel): each node's children are tested against all of them at once, and a ray drops out when it is found
 //! occluded; where too few of them enter a subtree, they walk on alone but interleaved. The shared walk's tests
-//! run in eight lanes, or in sixteen where the CPU has AVX-512 (`super::avx512`).
+//! run in eight lanes, or in sixteen where the CPU has AVX-512 (`super::avx512`). In a deep tree (a real mesh) the
+//! rays part within a few levels, and each walks alone, interleaved, from the root ([`SHARED_WALK_DEPTH`]).
 
 use super::Accel;
 #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
