@@ -8,10 +8,10 @@ use super::packet::NearestLanes;
 use super::ray::{RayLanes, WideRay};
 use super::shadow_bundle::{SET_ASIDE, SHARED_WALK_DEPTH};
 use super::{Accel, Hit, HitLanes};
-use crate::math::{Vec3x8, for_each_lane};
+use crate::math::{Vec3x8, for_each_lane, lane_mask};
 use arrayvec::ArrayVec;
 use glam::Vec3;
-use wide::{CmpEq, CmpLt, f32x8, i32x8};
+use wide::{CmpLt, f32x8};
 
 /// Each level pushes at most seven children (the eighth is visited at once).
 pub(super) const STACK: usize = 7 * MAX_DEPTH + 8;
@@ -105,7 +105,7 @@ impl Accel {
         let (mut current, mut lanes) = (root, active);
         loop {
             if current.is_leaf() {
-                let entered = lane_mask(lanes);
+                let entered: f32x8 = bytemuck::cast(lane_mask(lanes));
                 for packet in &self.packets[current.first as usize..(current.first + current.packets) as usize] {
                     packet.nearer_of_rays(&rays.o, &rays.d, entered, &mut nearest);
                 }
@@ -358,13 +358,6 @@ thread_local! {
     static WALKS: std::cell::RefCell<Box<[ClosestHitWalk; 8]>> = std::cell::RefCell::new(Box::new(
         std::array::from_fn(|_| ClosestHitWalk::new(Child { first: 0, packets: 0 }, Vec3::ZERO, Vec3::Z, 0.0)),
     ));
-}
-
-/// All bits set in lane l of the result for each bit l of `lanes` (as a comparison sets them).
-#[inline(always)]
-fn lane_mask(lanes: u32) -> f32x8 {
-    let bits = i32x8::new([1, 2, 4, 8, 16, 32, 64, 128]);
-    bytemuck::cast((i32x8::splat(lanes as i32) & bits).cmp_eq(bits))
 }
 
 /// A group to skip as the nodes store groups: its id, or [`SKIP_NOTHING`].
