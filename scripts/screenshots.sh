@@ -13,8 +13,8 @@ bin=$PWD/target/release/illumlab
 wait_s=${WAIT:-12}
 runtime=$(mktemp -d); chmod 700 "$runtime"; export XDG_RUNTIME_DIR=$runtime
 export XDG_CACHE_HOME=$runtime/cache
-shoot() { # scene strategy exposure
-  local out="screenshots/viewer-$1-$2.png"
+shoot() { # scene strategy exposure [name, for a scene given as a file]
+  local out="screenshots/viewer-${4:-$1}-$2.png"
   wanted "$out" || return 0
   xvfb-run -a -s "-screen 0 1280x800x24" bash -c "
     '$bin' view '$1' --strategy '$2' --exposure '$3' --target-spp 1024 & pid=\$!
@@ -31,6 +31,7 @@ shoot veach-mis emitter 0
 shoot veach-mis mis 0
 shoot near-light emitter -2
 shoot occluded-light guided 1
+shoot assets/knot-box/knot-box.toml emitter 0 knot-box
 shoot_compare() { # name warm-up-seconds seconds scene args…
   # The first run renders the reference into the cache, so the second records convergence from 1 spp.
   local out="screenshots/viewer-compare-$1.png" warm=$2 wait=$3 scene=$4; shift 4
