@@ -271,7 +271,7 @@ mod tests {
         }
         // A tree deeper than the shared walk pays in, whose any-hit walks push a node's children in one step.
         let deep = random_soup(40_000, 0.25, 40_000);
-        assert!(Accel::build(&deep, &groups_by_side(&deep)).0.depth > shadow_bundle::SHARED_WALK_DEPTH);
+        assert!(Accel::build(&deep, &groups_by_side(&deep)).0.walks_alone());
         check_against_brute_force(&deep, 300);
     }
 
@@ -287,7 +287,7 @@ mod tests {
         for (n, size) in [(1, 4.0), (9, 3.0), (100, 2.0), (3000, 0.8), (40_000, 0.25)] {
             let tris = random_soup(n, size, 40 + n as u64);
             let (accel, _) = Accel::build(&tris, &groups_by_side(&tris));
-            let alone_from_the_root = accel.depth > shadow_bundle::SHARED_WALK_DEPTH;
+            let alone_from_the_root = accel.walks_alone();
             assert_eq!(alone_from_the_root, n == 40_000, "soup {n}: a tree of {} levels", accel.depth);
             for group in 0..1500u64 {
                 let mut rng = SampleRng::new(17, group, n as u64);

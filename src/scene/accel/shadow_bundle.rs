@@ -30,10 +30,17 @@ pub(super) const SET_ASIDE: usize = 8;
 pub(super) const SHARED_WALK_DEPTH: usize = 4;
 
 impl Accel {
+    /// Whether this tree is deeper than [`SHARED_WALK_DEPTH`]: [`Accel::occluded_lanes`]'s rays each walk alone
+    /// from the root, and the any-hit step pushes a node's children in one step (`traverse::push_entered`).
+    #[inline(always)]
+    pub(super) fn walks_alone(&self) -> bool {
+        self.depth > SHARED_WALK_DEPTH
+    }
+
     /// How [`Accel::occluded_lanes`]'s rays walk this tree, for `render`, `bench` and the status bar: together, in
     /// the vectors [`vector_path`] chose, or each alone, in a tree deeper than [`SHARED_WALK_DEPTH`].
     pub fn shadow_walk(&self) -> String {
-        if self.depth > SHARED_WALK_DEPTH {
+        if self.walks_alone() {
             format!("single-ray walks ({}-level tree)", self.depth)
         } else {
             vector_path().name().to_string()
@@ -71,7 +78,7 @@ impl Accel {
         let Some(root) = self.root else { return 0 };
         let skips = skips.map(|s| s as i32);
         let mut alone: [AnyHitStack; 8] = Default::default();
-        if active.count_ones() < path.packet_min_rays() || self.depth > SHARED_WALK_DEPTH {
+        if active.count_ones() < path.packet_min_rays() || self.walks_alone() {
             for_each_lane(active, |l| alone[l].push(root));
             return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
         }

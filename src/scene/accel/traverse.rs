@@ -6,7 +6,7 @@ use super::build::MAX_DEPTH;
 use super::node::{Child, SKIP_NOTHING};
 use super::packet::NearestLanes;
 use super::ray::{RayLanes, WideRay};
-use super::shadow_bundle::{SET_ASIDE, SHARED_WALK_DEPTH};
+use super::shadow_bundle::SET_ASIDE;
 use super::{Accel, Hit, HitLanes};
 use crate::math::{Vec3x8, for_each_lane, lane_mask};
 use arrayvec::ArrayVec;
@@ -222,10 +222,10 @@ impl Accel {
 
     /// One step of an any-hit walk: takes the subtree on top of `stack` and tests a leaf's triangles, or takes the
     /// children of a node the ray enters (but those wholly in group `skip`); the order does not matter for any hit.
-    /// In a tree deeper than `shadow_bundle::SHARED_WALK_DEPTH` they all go on the stack in one step
-    /// ([`push_entered`]); in a smaller one, where a ray enters one or two children of a node and their leaves are
-    /// mostly a wall's, the nodes go on one by one and the leaves are tested at once (measured: 0.6% fewer
-    /// instructions on the Cornell box). True when a triangle in range was found; false also for an empty stack.
+    /// In a deep tree ([`Accel::walks_alone`]) they all go on the stack in one step ([`push_entered`]); in a
+    /// smaller one, where a ray enters one or two children of a node and their leaves are mostly a wall's, the
+    /// nodes go on one by one and the leaves are tested at once (measured: 0.6% fewer instructions on the Cornell
+    /// box). True when a triangle in range was found; false also for an empty stack.
     #[inline(always)]
     pub(super) fn occlusion_step(&self, stack: &mut AnyHitStack, ray: &WideRay, t_max: f32, skip: i32) -> bool {
         let leaf_hit = |leaf: Child| {
@@ -240,7 +240,7 @@ impl Accel {
         if skip != SKIP_NOTHING {
             mask &= !self.groups[current.first as usize].in_group(skip);
         }
-        if self.depth > SHARED_WALK_DEPTH {
+        if self.walks_alone() {
             push_entered(stack, &node.children, mask);
             return false;
         }
