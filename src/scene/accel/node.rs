@@ -13,7 +13,8 @@ pub(super) const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.
 const PAD_NEAR_ZERO: f32 = 1e-20;
 
 /// A child: a node, or a run of triangle packets (a leaf).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub(super) struct Child {
     /// Index of the node, or of the leaf's first packet.
     pub first: u32,
