@@ -1,7 +1,7 @@
 //! An 8-wide BVH node: the boxes of up to eight children in structure-of-arrays form, tested against one ray at
 //! once with the slab test (Kay & Kajiya 1986) made conservative as in Ize, "Robust BVH Ray Traversal" (2013).
 
-use super::ray::{RayLanes, WideRay};
+use super::ray::{Plane, RayLanes, WideRay};
 use glam::Vec3;
 use wide::{CmpEq, CmpLe, CmpLt, f32x8, i32x8};
 
@@ -76,7 +76,7 @@ impl Node8 {
     /// distances at which it enters them.
     #[inline(always)]
     pub fn intersect(&self, ray: &WideRay, t_max: f32) -> (u32, f32x8) {
-        let slab = |plane: [usize; 3], a: usize| (self.bounds[plane[a]] - ray.o[a]) * ray.inv_d[a];
+        let slab = |plane: [Plane; 3], a: usize| (self.bounds[plane[a] as usize] - ray.o[a]) * ray.inv_d[a];
         let t_enter = slab(ray.near, 0).fast_max(slab(ray.near, 1)).fast_max(slab(ray.near, 2).fast_max(f32x8::ZERO));
         let t_exit = slab(ray.far, 0).fast_min(slab(ray.far, 1)).fast_min(slab(ray.far, 2));
         let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));

@@ -15,10 +15,33 @@ pub(super) struct WideRay {
     pub o: [f32x8; 3],
     pub d: [f32x8; 3],
     pub inv_d: [f32x8; 3],
-    /// Per axis, the index in a node's `[min x, min y, min z, max x, max y, max z]` of the plane the ray
-    /// enters by (the min plane when it travels towards +axis), and of the one it leaves by.
-    pub near: [usize; 3],
-    pub far: [usize; 3],
+    /// Per axis, the plane the ray enters a box by (the min plane when it travels towards +axis), and the one it
+    /// leaves by.
+    pub near: [Plane; 3],
+    pub far: [Plane; 3],
+}
+
+/// One of the six planes of a box, as its index in a node's `[min x, min y, min z, max x, max y, max z]`: an
+/// enum, so that indexing with it needs no bounds check (with six checked `usize` indices, the knot's shadow-ray
+/// walks took 112.3 M instructions instead of 100.1 M: callgrind, `emitter`, 128², 16 spp).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub(super) enum Plane {
+    MinX,
+    MinY,
+    MinZ,
+    MaxX,
+    MaxY,
+    MaxZ,
+}
+
+impl Plane {
+    /// Of axis a (0, 1, 2): the max plane if `max`, else the min plane.
+    const fn of_axis(a: usize, max: bool) -> Self {
+        const PLANES: [[Plane; 3]; 2] =
+            [[Plane::MinX, Plane::MinY, Plane::MinZ], [Plane::MaxX, Plane::MaxY, Plane::MaxZ]];
+        PLANES[max as usize][a]
+    }
 }
 
 impl WideRay {
@@ -28,13 +51,13 @@ impl WideRay {
         let tiny = d.abs().cmplt(Vec3A::splat(MIN_COMPONENT));
         let inv = Vec3A::select(tiny, Vec3A::splat(MIN_COMPONENT).copysign(d), d).recip();
         let negative = inv.is_negative_bitmask();
-        let near = [0, 1, 2].map(|a| if negative & (1 << a) != 0 { a + 3 } else { a });
+        let towards_min = [0, 1, 2].map(|a| negative & (1 << a) != 0);
         Self {
             o: origin.to_array().map(f32x8::splat),
             d: dir.to_array().map(f32x8::splat),
             inv_d: inv.to_array().map(f32x8::splat),
-            near,
-            far: near.map(|i| (i + 3) % 6),
+            near: [0, 1, 2].map(|a| Plane::of_axis(a, towards_min[a])),
+            far: [0, 1, 2].map(|a| Plane::of_axis(a, !towards_min[a])),
         }
     }
 }
