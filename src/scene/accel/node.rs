@@ -1,7 +1,7 @@
 //! An 8-wide BVH node: the boxes of up to eight children in structure-of-arrays form, tested against one ray at
 //! once with the slab test (Kay & Kajiya 1986) made conservative as in Ize, "Robust BVH Ray Traversal" (2013).
 
-use super::ray::{Plane, RayLanes, WideRay};
+use super::ray::{RayLanes, WideRay};
 use glam::Vec3;
 use wide::{CmpEq, CmpLe, CmpLt, f32x8, i32x8};
 
@@ -76,9 +76,13 @@ impl Node8 {
     /// distances at which it enters them.
     #[inline(always)]
     pub fn intersect(&self, ray: &WideRay, t_max: f32) -> (u32, f32x8) {
-        let slab = |plane: [Plane; 3], a: usize| (self.bounds[plane[a] as usize] - ray.o[a]) * ray.inv_d[a];
-        let t_enter = slab(ray.near, 0).fast_max(slab(ray.near, 1)).fast_max(slab(ray.near, 2).fast_max(f32x8::ZERO));
-        let t_exit = slab(ray.far, 0).fast_min(slab(ray.far, 1)).fast_min(slab(ray.far, 2));
+        let slab = |a: usize, near: bool| {
+            let (lo, hi) = (self.bounds[a], self.bounds[a + 3]);
+            let plane = if near { ray.negative[a].blend(hi, lo) } else { ray.negative[a].blend(lo, hi) };
+            (plane - ray.o[a]) * ray.inv_d[a]
+        };
+        let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
+        let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
         let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));
         (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
     }
