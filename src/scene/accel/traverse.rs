@@ -332,10 +332,11 @@ const ANY_HIT_ROOM: usize = SET_ASIDE + STACK + 8;
 pub(super) type AnyHitStack = ArrayVec<Child, ANY_HIT_ROOM>;
 
 /// Pushes `children[k]` for each bit k of `mask` (in increasing k: the last one is popped first) in one step:
-/// eight children copied through [`COMPACT`], then the length cut to their number, with no branch that depends
-/// on which children a ray enters (what a CPU mispredicts most in a walk, since every ray enters others). With
-/// leaves pushed like nodes and tested when popped, the knot's shadow rays walking alone took 18% less time than
-/// with the children pushed one by one and the leaves tested at once (see `shadow_bundle::SHARED_WALK_DEPTH`).
+/// eight children copied in [`COMPACT`]'s order (`compacted`), then the length cut to their number, with no
+/// branch that depends on which children a ray enters (what a CPU mispredicts most in a walk, since every ray
+/// enters others). With leaves pushed like nodes and tested when popped, the knot's shadow rays walking alone took
+/// 18% less time than with the children pushed one by one and the leaves tested at once (see
+/// `shadow_bundle::SHARED_WALK_DEPTH`).
 #[inline(always)]
 pub(super) fn push_entered(stack: &mut AnyHitStack, children: &[Child; 8], mask: u32) {
     let len = stack.len();
