@@ -76,15 +76,8 @@ impl Node8 {
     /// distances at which it enters them.
     #[inline(always)]
     pub fn intersect(&self, ray: &WideRay, t_max: f32) -> (u32, f32x8) {
-        let slab = |a: usize, near: bool| {
-            let (lo, hi) = (self.bounds[a], self.bounds[a + 3]);
-            let plane = if near { ray.negative[a].blend(hi, lo) } else { ray.negative[a].blend(lo, hi) };
-            (plane - ray.o[a]) * ray.inv_d[a]
-        };
-        let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
-        let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
-        let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(f32x8::splat(t_max));
-        (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
+        let [x0, y0, z0, x1, y1, z1] = self.bounds;
+        slab_test([x0, y0, z0], [x1, y1, z1], &ray.o, &ray.inv_d, &ray.negative, f32x8::splat(t_max))
     }
 
     /// The rays of `rays` (bit i for lane i) whose slab test against child `k`'s box passes: bit i is bit k of
@@ -98,16 +91,8 @@ impl Node8 {
     /// rays enter the box: lane i is lane k of [`Node8::intersect`]'s for ray i.
     #[inline(always)]
     pub fn enter_lanes(&self, k: usize, rays: &RayLanes, t_max: f32x8) -> (u32, f32x8) {
-        let slab = |a: usize, near: bool| {
-            let (lo, hi) =
-                (f32x8::splat(self.bounds[a].as_array_ref()[k]), f32x8::splat(self.bounds[a + 3].as_array_ref()[k]));
-            let plane = if near { rays.negative[a].blend(hi, lo) } else { rays.negative[a].blend(lo, hi) };
-            (plane - rays.o[a]) * rays.inv_d[a]
-        };
-        let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
-        let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
-        let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(t_max);
-        (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
+        let plane = |p: usize| f32x8::splat(self.bounds[p].as_array_ref()[k]);
+        slab_test([0, 1, 2].map(plane), [3, 4, 5].map(plane), &rays.o, &rays.inv_d, &rays.negative, t_max)
     }
 
     /// min x, min y, min z, max x, max y, max z of the children's boxes, child k in lane k.
@@ -138,6 +123,30 @@ impl Node8 {
         }
         !(outside.move_mask() as u32) & self.used
     }
+}
+
+/// The slab test of boxes against rays `o + t·d`, lane by lane: box `lo`–`hi` (per axis) against the ray with
+/// `inv_d` = 1/d and `negative` all bits set where d < 0 (it enters by the max plane). Returns the lanes whose box
+/// the ray overlaps for some `0 ≤ t ≤ t_max` and the distances at which it enters them. One ray against eight
+/// boxes ([`Node8::intersect`]) and eight rays against one box ([`Node8::enter_lanes`]) run it alike, so their
+/// answers agree bit for bit.
+#[inline(always)]
+fn slab_test(
+    lo: [f32x8; 3],
+    hi: [f32x8; 3],
+    o: &[f32x8; 3],
+    inv_d: &[f32x8; 3],
+    negative: &[f32x8; 3],
+    t_max: f32x8,
+) -> (u32, f32x8) {
+    let slab = |a: usize, near: bool| {
+        let plane = if near { negative[a].blend(hi[a], lo[a]) } else { negative[a].blend(lo[a], hi[a]) };
+        (plane - o[a]) * inv_d[a]
+    };
+    let t_enter = slab(0, true).fast_max(slab(1, true)).fast_max(slab(2, true).fast_max(f32x8::ZERO));
+    let t_exit = slab(0, false).fast_min(slab(1, false)).fast_min(slab(2, false));
+    let t_exit = (t_exit * f32x8::splat(ROBUST_EXIT)).fast_min(t_max);
+    (t_enter.cmp_le(t_exit).move_mask() as u32, t_enter)
 }
 
 impl ChildGroups {

@@ -27,13 +27,13 @@ impl WideRay {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
         let d = Vec3A::from(dir);
         let tiny = d.abs().cmplt(Vec3A::splat(MIN_COMPONENT));
-        let inv = Vec3A::select(tiny, Vec3A::splat(MIN_COMPONENT).copysign(d), d).recip();
-        let negative = inv.is_negative_bitmask();
+        let inv_d =
+            Vec3A::select(tiny, Vec3A::splat(MIN_COMPONENT).copysign(d), d).recip().to_array().map(f32x8::splat);
         Self {
             o: origin.to_array().map(f32x8::splat),
             d: dir.to_array().map(f32x8::splat),
-            inv_d: inv.to_array().map(f32x8::splat),
-            negative: [0, 1, 2].map(|a| bytemuck::cast(wide::i32x8::splat(-(((negative >> a) & 1) as i32)))),
+            inv_d,
+            negative: inv_d.map(sign_mask),
         }
     }
 }
@@ -55,10 +55,14 @@ impl RayLanes {
             let tiny = d.abs().cmp_lt(f32x8::splat(MIN_COMPONENT));
             f32x8::ONE / tiny.blend(f32x8::splat(MIN_COMPONENT).copysign(d), d)
         });
-        // The sign bit of 1/d, spread over the lane: an arithmetic shift of the bits.
-        let negative = inv_d.map(|inv| bytemuck::cast(bytemuck::cast::<f32x8, wide::i32x8>(inv) >> 31));
-        Self { o: [origins.x, origins.y, origins.z], d, inv_d, negative }
+        Self { o: [origins.x, origins.y, origins.z], d, inv_d, negative: inv_d.map(sign_mask) }
     }
+}
+
+/// Each lane's sign bit spread over the lane (all bits set where it is negative): an arithmetic shift of the bits.
+#[inline(always)]
+fn sign_mask(v: f32x8) -> f32x8 {
+    bytemuck::cast(bytemuck::cast::<f32x8, wide::i32x8>(v) >> 31)
 }
 
 /// The tests the eight rays of a shared walk (`Accel::occluded_lanes`) run at its nodes and leaves: in eight
