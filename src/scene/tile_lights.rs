@@ -12,7 +12,7 @@
 //! group); the shaft's fronts leave out everything on or behind either plane. Δ is clear when every
 //! footprint's shaft holds no other triangle, listed when all of them hold few.
 
-use super::{Scene, ShadowBlockers};
+use super::{Scene, ShadowBlockers, Shaft, ShaftEntry};
 use crate::math::gamma;
 use arrayvec::ArrayVec;
 use glam::Vec3;
@@ -34,11 +34,14 @@ pub struct TileLights {
     pub clear: u32,
     /// For some other slots ([`ShadowBlockers::lights`]), every triangle that can stop their rays.
     pub blockers: Option<Box<ShadowBlockers>>,
+    /// For the slots whose rays walk the tree (neither clear nor listed), where they start: their shafts' cut
+    /// ([`crate::scene::Accel::shaft_entry`]), by slot.
+    pub entries: Option<Box<[Option<ShaftEntry>]>>,
 }
 
 impl TileLights {
     /// Nothing known: every shadow ray walks the tree.
-    pub const NONE: Self = Self { clear: 0, blockers: None };
+    pub const NONE: Self = Self { clear: 0, blockers: None, entries: None };
 }
 
 impl Scene {
@@ -54,10 +57,13 @@ impl Scene {
         let mut clear = 0;
         // The blockers of the slots listed so far, with the slots whose rays each may stop.
         let (mut blockers, mut listed) = (ArrayVec::<(u32, u32), 8>::new(), 0);
+        let mut entries: Vec<Option<ShaftEntry>> = Vec::new();
         for (slot, &light) in self.emitters.iter().enumerate() {
             let mut found = ArrayVec::<u32, 8>::new();
-            let shafts = footprints.iter().map(|f| self.light_blockers(eye, f, own_error, light, candidates));
-            let all = shafts.into_iter().try_for_each(|in_shaft| {
+            let mut shafts = ArrayVec::<Shaft, MAX_PLANES>::new();
+            let all = footprints.iter().try_for_each(|f| {
+                let (shaft, in_shaft) = self.light_blockers(eye, f, own_error, light, candidates)?;
+                shafts.push(shaft);
                 for t in in_shaft? {
                     if !found.contains(&t) {
                         found.try_push(t).ok()?;
@@ -65,8 +71,15 @@ impl Scene {
                 }
                 Some(())
             });
+            let mut walk = |shafts: &[Shaft]| {
+                if shafts.len() == footprints.len() {
+                    entries.resize(self.emitters.len(), None);
+                    entries[slot] = self.accel().shaft_entry(shafts);
+                }
+            };
             if all.is_none() {
-                continue; // these rays walk the tree
+                walk(&shafts); // these rays walk the tree
+                continue;
             }
             if found.is_empty() {
                 clear |= 1 << slot;
@@ -74,7 +87,8 @@ impl Scene {
             }
             let new = found.iter().filter(|&&t| !blockers.iter().any(|b| b.0 == t)).count();
             if blockers.len() + new > 8 {
-                continue; // these too
+                walk(&shafts); // these too
+                continue;
             }
             for t in found {
                 match blockers.iter_mut().find(|b| b.0 == t) {
@@ -88,7 +102,8 @@ impl Scene {
             let triangle = |i: usize| (self.triangles[blockers[i].0 as usize].v, blockers[i].0, blockers[i].1);
             Box::new(ShadowBlockers::new(blockers.len(), triangle, listed))
         });
-        TileLights { clear, blockers }
+        let entries = entries.iter().any(Option::is_some).then(|| entries.into_boxed_slice());
+        TileLights { clear, blockers, entries }
     }
 
     /// The candidates' planes (`(n, d)`, n towards the eye; a triangle whose vertices all lie in a plane found
@@ -128,7 +143,7 @@ impl Scene {
         own_error: f32,
         light: u32,
         candidates: &[u32],
-    ) -> Option<ArrayVec<u32, 8>> {
+    ) -> Option<(Shaft, Option<ArrayVec<u32, 8>>)> {
         let tri = &self.triangles[light as usize];
         let points = footprint.iter().chain(&tri.v);
         let scale = points.clone().chain([&eye]).map(|p| p.abs().max_element()).fold(0.0, f32::max);
@@ -150,7 +165,8 @@ impl Scene {
                 || (candidates.len() == 1 && t == candidates[0])
                 || (group.is_some() && self.convex_group(t) == group)
         };
-        self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET)
+        let blockers = self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET);
+        Some((shaft, blockers))
     }
 }
 
