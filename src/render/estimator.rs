@@ -214,7 +214,7 @@ pub(super) fn visible_lanes(
             let slots = slots.to_array();
             for_each_lane(walking, |l| entries[l] = entered.get(slots[l] as usize).and_then(Option::as_ref));
         }
-        occluded |= scene.accel().occluded_lanes_entering(&from, &(to - from), SEGMENT_END, walking, skips, &entries);
+        occluded |= scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, walking, skips, &entries);
     }
     active & !occluded
 }

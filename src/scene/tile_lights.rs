@@ -10,7 +10,9 @@
 //! shadow rays cannot hit by construction: the one the footprint lies on when it is the only candidate (the ray
 //! starts off it, `math::offset`), Δ itself and its convex group (the ray ends in front of Δ, and skips the
 //! group); the shaft's fronts leave out everything on or behind either plane. Δ is clear when every
-//! footprint's shaft holds no other triangle, listed when all of them hold few.
+//! footprint's shaft holds no other triangle, listed when all of them hold few. Where they hold many (a real mesh
+//! in the way), the rays still walk the tree, but from the shafts' cut (`Accel::shaft_entry`): the subtrees that
+//! hold everything in them, without the steps down to them.
 
 use super::{Scene, ShadowBlockers, Shaft, ShaftEntry};
 use crate::math::gamma;

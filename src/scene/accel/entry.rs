@@ -30,7 +30,7 @@ struct Member {
 
 impl Accel {
     /// The cut the rays in `shafts` (their union) start from, in a tree whose rays walk alone
-    /// ([`Accel::walks_alone`]); `None` where it would be the root's own children.
+    /// (`Accel::walks_alone`); `None` where it would be the root's own children.
     pub fn shaft_entry(&self, shafts: &[Shaft]) -> Option<ShaftEntry> {
         let root = self.root.filter(|r| !r.is_leaf() && self.walks_alone())?;
         // The children of a node some shaft does not clear.
@@ -130,7 +130,7 @@ mod tests {
                 let skips: [u32; 8] = std::array::from_fn(|l| [SKIP_NONE, 0, 1][(bundle + l) % 3]);
                 let [origins, dirs] = [rays.map(|r| r.0), rays.map(|r| r.1)].map(|v| Vec3x8::from_lanes(&v));
                 let t_max = 1.0 - 1e-6;
-                let bits = accel.occluded_lanes_entering(&origins, &dirs, t_max, 0xff, skips, &[Some(&entry); 8]);
+                let bits = accel.occluded_lanes(&origins, &dirs, t_max, 0xff, skips, &[Some(&entry); 8]);
                 for (l, &(o, d)) in rays.iter().enumerate() {
                     let skip = Some(skips[l]).filter(|&s| s != SKIP_NONE);
                     let from_root = accel.occluded(o, d, t_max, skip);

@@ -2,7 +2,8 @@
 //! pixel): each node's children are tested against all of them at once, and a ray drops out when it is found
 //! occluded; where too few of them enter a subtree, they walk on alone but interleaved. The shared walk's tests
 //! run in eight lanes, or in sixteen where the CPU has AVX-512 (`super::avx512`). In a deep tree (a real mesh) the
-//! rays part within a few levels, and each walks alone, interleaved, from the root ([`SHARED_WALK_DEPTH`]).
+//! rays part within a few levels, and each walks alone, interleaved, from the root ([`SHARED_WALK_DEPTH`]) or
+//! from its shaft's cut (`super::entry`).
 
 use super::Accel;
 #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
@@ -59,16 +60,10 @@ impl Accel {
     /// on the stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
     /// (`Accel::walk_alone`): before the shared walk goes on with one of them (it may be occluded by then), when
     /// one has `SET_ASIDE` subtrees set aside, and at the end. Where the rays part at the root (lights in
-    /// different places), they all walk alone together.
+    /// different places), they all walk alone together. In a deep tree, ray l starts its walk at `entries[l]`
+    /// where given: the cut of a shaft that holds it ([`Accel::shaft_entry`]).
     #[inline]
-    pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32, skips: [u32; 8]) -> u32 {
-        self.occluded_lanes_on(vector_path(), origins, dirs, t_max, active, skips, &[None; 8])
-    }
-
-    /// [`Accel::occluded_lanes`] with ray l starting its walk at `entries[l]` where given: the cut of the shaft
-    /// that holds it ([`Accel::shaft_entry`]).
-    #[inline]
-    pub fn occluded_lanes_entering(
+    pub fn occluded_lanes(
         &self,
         origins: &Vec3x8,
         dirs: &Vec3x8,
