@@ -212,7 +212,8 @@ pub(super) fn visible_lanes(
         let mut entries = [None; 8];
         if let Some((entered, slots)) = tile.and_then(|(tile, slots)| Some((tile.entries.as_deref()?, slots))) {
             let slots = slots.to_array();
-            for_each_lane(walking, |l| entries[l] = entered.get(slots[l] as usize).and_then(Option::as_ref));
+            let of = |slot: i32| entered.iter().find(|(s, _)| *s as i32 == slot).map(|(_, entry)| entry);
+            for_each_lane(walking, |l| entries[l] = of(slots[l]));
         }
         occluded |= scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, walking, skips, &entries);
     }

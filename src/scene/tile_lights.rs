@@ -36,9 +36,9 @@ pub struct TileLights {
     pub clear: u32,
     /// For some other slots ([`ShadowBlockers::lights`]), every triangle that can stop their rays.
     pub blockers: Option<Box<ShadowBlockers>>,
-    /// For the slots whose rays walk the tree (neither clear nor listed), where they start: their shafts' cut
-    /// ([`crate::scene::Accel::shaft_entry`]), by slot.
-    pub entries: Option<Box<[Option<ShaftEntry>]>>,
+    /// For some slots whose rays walk the tree (neither clear nor listed), where they start: their shafts' cut
+    /// ([`crate::scene::Accel::shaft_entry`]), with the slot (only those with one: a cut is 320 bytes).
+    pub entries: Option<Box<[(u32, ShaftEntry)]>>,
 }
 
 impl TileLights {
@@ -59,7 +59,7 @@ impl Scene {
         let mut clear = 0;
         // The blockers of the slots listed so far, with the slots whose rays each may stop.
         let (mut blockers, mut listed) = (ArrayVec::<(u32, u32), 8>::new(), 0);
-        let mut entries: Vec<Option<ShaftEntry>> = Vec::new();
+        let mut entries = Vec::new();
         for (slot, &light) in self.emitters.iter().enumerate() {
             let mut found = ArrayVec::<u32, 8>::new();
             let mut shafts = ArrayVec::<Shaft, MAX_PLANES>::new();
@@ -75,8 +75,7 @@ impl Scene {
             });
             let mut walk = |shafts: &[Shaft]| {
                 if shafts.len() == footprints.len() {
-                    entries.resize(self.emitters.len(), None);
-                    entries[slot] = self.accel().shaft_entry(shafts);
+                    entries.extend(self.accel().shaft_entry(shafts).map(|entry| (slot as u32, entry)));
                 }
             };
             if all.is_none() {
@@ -104,7 +103,7 @@ impl Scene {
             let triangle = |i: usize| (self.triangles[blockers[i].0 as usize].v, blockers[i].0, blockers[i].1);
             Box::new(ShadowBlockers::new(blockers.len(), triangle, listed))
         });
-        let entries = entries.iter().any(Option::is_some).then(|| entries.into_boxed_slice());
+        let entries = (!entries.is_empty()).then(|| entries.into_boxed_slice());
         TileLights { clear, blockers, entries }
     }
 
