@@ -116,10 +116,7 @@ fn rays(c: &mut Criterion) {
             b.iter(|| {
                 let mut blocked = 0u32;
                 for (o, d, active) in &work.shadow_lanes {
-                    blocked += scene
-                        .accel()
-                        .occluded_lanes(o, d, SEGMENT_END, *active, [SKIP_NONE; 8], &[None; 8])
-                        .count_ones();
+                    blocked += scene.accel().occluded_lanes(o, d, SEGMENT_END, *active, [SKIP_NONE; 8]).count_ones();
                 }
                 black_box(blocked)
             })

@@ -4,7 +4,7 @@
 use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
-use crate::math::{SampleRng, SurfaceError, Vec3x8, for_each_lane, lanes_in, offset_ray_origin, offset_ray_origins};
+use crate::math::{SampleRng, SurfaceError, Vec3x8, lanes_in, offset_ray_origin, offset_ray_origins};
 use crate::scene::{EmitterSampler, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
 use wide::{CmpGt, f32x8, i32x8};
@@ -209,13 +209,7 @@ pub(super) fn visible_lanes(
             let in_front = n_x.dot(from - x).cmp_gt(f32x8::ZERO).move_mask();
             skips = std::array::from_fn(|l| if in_front & (1 << l) != 0 { groups[l] } else { SKIP_NONE });
         }
-        let mut entries = [None; 8];
-        if let Some((entered, slots)) = tile.and_then(|(tile, slots)| Some((tile.entries.as_deref()?, slots))) {
-            let slots = slots.to_array();
-            let of = |slot: i32| entered.iter().find(|(s, _)| *s as i32 == slot).map(|(_, entry)| entry);
-            for_each_lane(walking, |l| entries[l] = of(slots[l]));
-        }
-        occluded |= scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, walking, skips, &entries);
+        occluded |= scene.accel().occluded_lanes(&from, &(to - from), SEGMENT_END, walking, skips);
     }
     active & !occluded
 }

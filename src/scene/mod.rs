@@ -18,8 +18,8 @@ mod tile_lights;
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
 pub use accel::{
-    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, ShaftEntry, VectorPath,
-    has_avx512, vector_path,
+    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, VectorPath, has_avx512,
+    vector_path,
 };
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;

@@ -10,11 +10,9 @@
 //! shadow rays cannot hit by construction: the one the footprint lies on when it is the only candidate (the ray
 //! starts off it, `math::offset`), Δ itself and its convex group (the ray ends in front of Δ, and skips the
 //! group); the shaft's fronts leave out everything on or behind either plane. Δ is clear when every
-//! footprint's shaft holds no other triangle, listed when all of them hold few. Where they hold many (a real mesh
-//! in the way), the rays still walk the tree, but from the shafts' cut (`Accel::shaft_entry`): the subtrees that
-//! hold everything in them, without the steps down to them.
+//! footprint's shaft holds no other triangle, listed when all of them hold few.
 
-use super::{Scene, ShadowBlockers, Shaft, ShaftEntry};
+use super::{Scene, ShadowBlockers};
 use crate::math::gamma;
 use arrayvec::ArrayVec;
 use glam::Vec3;
@@ -36,14 +34,11 @@ pub struct TileLights {
     pub clear: u32,
     /// For some other slots ([`ShadowBlockers::lights`]), every triangle that can stop their rays.
     pub blockers: Option<Box<ShadowBlockers>>,
-    /// For some slots whose rays walk the tree (neither clear nor listed), where they start: their shafts' cut
-    /// ([`crate::scene::Accel::shaft_entry`]), with the slot (only those with one: a cut is 320 bytes).
-    pub entries: Option<Box<[(u32, ShaftEntry)]>>,
 }
 
 impl TileLights {
     /// Nothing known: every shadow ray walks the tree.
-    pub const NONE: Self = Self { clear: 0, blockers: None, entries: None };
+    pub const NONE: Self = Self { clear: 0, blockers: None };
 }
 
 impl Scene {
@@ -59,13 +54,10 @@ impl Scene {
         let mut clear = 0;
         // The blockers of the slots listed so far, with the slots whose rays each may stop.
         let (mut blockers, mut listed) = (ArrayVec::<(u32, u32), 8>::new(), 0);
-        let mut entries = Vec::new();
         for (slot, &light) in self.emitters.iter().enumerate() {
             let mut found = ArrayVec::<u32, 8>::new();
-            let mut shafts = ArrayVec::<Shaft, MAX_PLANES>::new();
-            let all = footprints.iter().try_for_each(|f| {
-                let (shaft, in_shaft) = self.light_blockers(eye, f, own_error, light, candidates)?;
-                shafts.push(shaft);
+            let shafts = footprints.iter().map(|f| self.light_blockers(eye, f, own_error, light, candidates));
+            let all = shafts.into_iter().try_for_each(|in_shaft| {
                 for t in in_shaft? {
                     if !found.contains(&t) {
                         found.try_push(t).ok()?;
@@ -73,14 +65,8 @@ impl Scene {
                 }
                 Some(())
             });
-            let mut walk = |shafts: &[Shaft]| {
-                if shafts.len() == footprints.len() {
-                    entries.extend(self.accel().shaft_entry(shafts).map(|entry| (slot as u32, entry)));
-                }
-            };
             if all.is_none() {
-                walk(&shafts); // these rays walk the tree
-                continue;
+                continue; // these rays walk the tree
             }
             if found.is_empty() {
                 clear |= 1 << slot;
@@ -88,8 +74,7 @@ impl Scene {
             }
             let new = found.iter().filter(|&&t| !blockers.iter().any(|b| b.0 == t)).count();
             if blockers.len() + new > 8 {
-                walk(&shafts); // these too
-                continue;
+                continue; // these too
             }
             for t in found {
                 match blockers.iter_mut().find(|b| b.0 == t) {
@@ -103,8 +88,7 @@ impl Scene {
             let triangle = |i: usize| (self.triangles[blockers[i].0 as usize].v, blockers[i].0, blockers[i].1);
             Box::new(ShadowBlockers::new(blockers.len(), triangle, listed))
         });
-        let entries = (!entries.is_empty()).then(|| entries.into_boxed_slice());
-        TileLights { clear, blockers, entries }
+        TileLights { clear, blockers }
     }
 
     /// The candidates' planes (`(n, d)`, n towards the eye; a triangle whose vertices all lie in a plane found
@@ -144,7 +128,7 @@ impl Scene {
         own_error: f32,
         light: u32,
         candidates: &[u32],
-    ) -> Option<(Shaft, Option<ArrayVec<u32, 8>>)> {
+    ) -> Option<ArrayVec<u32, 8>> {
         let tri = &self.triangles[light as usize];
         let points = footprint.iter().chain(&tri.v);
         let scale = points.clone().chain([&eye]).map(|p| p.abs().max_element()).fold(0.0, f32::max);
@@ -166,8 +150,7 @@ impl Scene {
                 || (candidates.len() == 1 && t == candidates[0])
                 || (group.is_some() && self.convex_group(t) == group)
         };
-        let blockers = self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET);
-        Some((shaft, blockers))
+        self.accel().shaft_blockers(&shaft, left_out, SHAFT_BUDGET)
     }
 }
 

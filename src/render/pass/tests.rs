@@ -101,39 +101,3 @@ fn any_split_into_passes_gives_the_same_film() {
         }
     }
 }
-
-/// On the knot (a tree deep enough for shadow rays to walk alone), the light strategies and MIS give in one
-/// pass of thirteen samples, where the tiles' shadow rays start at their shafts' entries
-/// (`Accel::shaft_entry`), the film they give one sample at a time from the root; and some tile has an entry,
-/// so the test walks from one.
-#[test]
-fn the_knots_shadow_rays_from_their_shafts_entries_give_the_same_film() {
-    let scene = Arc::new(crate::scene::load_scene("assets/knot-box/knot-box.toml").expect("the knot loads"));
-    let camera = Camera { width: 40, height: 30, ..scene.camera };
-    let strategies = [Strategy::Emitter, Strategy::SolidAngle, Strategy::Mis];
-    let mut entered = 0;
-    for strategy in strategies {
-        let settings = RenderSettings { strategy, seed: 5, ..Default::default() };
-        let film = |passes: &[u32]| {
-            let mut renderer = Renderer::with_camera(scene.clone(), settings, &camera);
-            let mut film = Film::new(camera.width, camera.height);
-            let mut first = 0;
-            for &count in passes {
-                renderer.render_pass(&mut film, first, count, &|| false);
-                first += count;
-            }
-            (film, renderer.cones())
-        };
-        let (together, cones) = film(&[13]);
-        assert!(
-            together.pixels == film(&[1; 13]).0.pixels,
-            "{}: one pass differs from one sample at a time",
-            strategy.name()
-        );
-        let basis = camera.basis();
-        for y in 0..camera.height {
-            entered += cones.row(&scene, &basis, y, camera.width).filter(|(_, tile)| tile.entries.is_some()).count();
-        }
-    }
-    assert!(entered > 0, "no tile's shadow rays start at an entry: the test walks none");
-}

@@ -10,7 +10,6 @@
 mod avx512;
 mod blockers;
 mod build;
-mod entry;
 mod frustum;
 mod node;
 mod packet;
@@ -21,7 +20,6 @@ mod traverse;
 mod vectors;
 
 pub use blockers::ShadowBlockers;
-pub use entry::ShaftEntry;
 pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
@@ -305,18 +303,9 @@ mod tests {
                 let t_max = [1.0 - 1e-6, 0.5, f32::INFINITY][group as usize % 3];
                 let skips = std::array::from_fn(|l| [SKIP_NONE, 0, 1][(group as usize + l) % 3]);
                 let (origins_x8, dirs_x8) = (Vec3x8::from_lanes(&origins), Vec3x8::from_lanes(&dirs));
-                let bits =
-                    accel.occluded_lanes_on(VectorPath::Avx2, &origins_x8, &dirs_x8, t_max, active, skips, &[None; 8]);
+                let bits = accel.occluded_lanes_on(VectorPath::Avx2, &origins_x8, &dirs_x8, t_max, active, skips);
                 if has_avx512() {
-                    let wide = accel.occluded_lanes_on(
-                        VectorPath::Avx512,
-                        &origins_x8,
-                        &dirs_x8,
-                        t_max,
-                        active,
-                        skips,
-                        &[None; 8],
-                    );
+                    let wide = accel.occluded_lanes_on(VectorPath::Avx512, &origins_x8, &dirs_x8, t_max, active, skips);
                     assert_eq!(wide, bits, "soup {n}, group {group}: 16 lanes answer otherwise than 8");
                 }
                 for l in 0..8 {

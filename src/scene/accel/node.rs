@@ -72,28 +72,6 @@ impl Node8 {
         Self { bounds: [x0, y0, z0, x1, y1, z1], children: kids, used: (1u32 << children.len()) - 1 }
     }
 
-    /// A node whose child i is child `k` of node `n` for the i-th `(n, k)` of `members`, with its box as `n`
-    /// holds it.
-    pub fn gathered(members: &[(&Node8, usize)]) -> Self {
-        assert!(members.len() <= 8, "a node has at most eight children");
-        let mut bounds = [
-            [f32::INFINITY; 8],
-            [f32::INFINITY; 8],
-            [f32::INFINITY; 8],
-            [f32::NEG_INFINITY; 8],
-            [f32::NEG_INFINITY; 8],
-            [f32::NEG_INFINITY; 8],
-        ];
-        let mut children = [Child::default(); 8];
-        for (lane, &(node, k)) in members.iter().enumerate() {
-            for (plane, b) in bounds.iter_mut().enumerate() {
-                b[lane] = node.bounds[plane].as_array_ref()[k];
-            }
-            children[lane] = node.children[k];
-        }
-        Self { bounds: bounds.map(f32x8::new), children, used: (1u32 << members.len()) - 1 }
-    }
-
     /// The lanes whose box the ray `o + t·d` overlaps for some `0 ≤ t ≤ t_max` (bit i for child i), and the
     /// distances at which it enters them.
     #[inline(always)]

@@ -2,17 +2,14 @@
 //! pixel): each node's children are tested against all of them at once, and a ray drops out when it is found
 //! occluded; where too few of them enter a subtree, they walk on alone but interleaved. The shared walk's tests
 //! run in eight lanes, or in sixteen where the CPU has AVX-512 (`super::avx512`). In a deep tree (a real mesh) the
-//! rays part within a few levels, and each walks alone, interleaved, from the root ([`SHARED_WALK_DEPTH`]) or
-//! from its shaft's cut (`super::entry`).
+//! rays part within a few levels, and each walks alone, interleaved, from the root ([`SHARED_WALK_DEPTH`]).
 
 use super::Accel;
 #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
 use super::avx512;
 use super::build::MAX_DEPTH;
-use super::entry::ShaftEntry;
 use super::node::{Child, SKIP_NOTHING};
 use super::ray::{BundleTests, RayLanes, WideRay};
-use super::traverse::push_entered;
 use super::traverse::{AnyHitStack, STACK};
 use super::vectors::{VectorPath, vector_path};
 use crate::math::{Vec3x8, for_each_lane};
@@ -60,25 +57,15 @@ impl Accel {
     /// on the stack of each of them, and the rays with subtrees set aside walk them alone but interleaved
     /// (`Accel::walk_alone`): before the shared walk goes on with one of them (it may be occluded by then), when
     /// one has `SET_ASIDE` subtrees set aside, and at the end. Where the rays part at the root (lights in
-    /// different places), they all walk alone together. In a deep tree, ray l starts its walk at `entries[l]`
-    /// where given: the cut of a shaft that holds it ([`Accel::shaft_entry`]).
+    /// different places), they all walk alone together.
     #[inline]
-    pub fn occluded_lanes(
-        &self,
-        origins: &Vec3x8,
-        dirs: &Vec3x8,
-        t_max: f32,
-        active: u32,
-        skips: [u32; 8],
-        entries: &[Option<&ShaftEntry>; 8],
-    ) -> u32 {
-        self.occluded_lanes_on(vector_path(), origins, dirs, t_max, active, skips, entries)
+    pub fn occluded_lanes(&self, origins: &Vec3x8, dirs: &Vec3x8, t_max: f32, active: u32, skips: [u32; 8]) -> u32 {
+        self.occluded_lanes_on(vector_path(), origins, dirs, t_max, active, skips)
     }
 
     /// [`Accel::occluded_lanes`] with the shared walk's tests in `path`'s vectors (the same answers on every
     /// path; [`VectorPath::Avx512`] only where the CPU has it, or this panics).
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     pub fn occluded_lanes_on(
         &self,
         path: VectorPath,
@@ -87,19 +74,13 @@ impl Accel {
         t_max: f32,
         active: u32,
         skips: [u32; 8],
-        entries: &[Option<&ShaftEntry>; 8],
     ) -> u32 {
         let Some(root) = self.root else { return 0 };
         let skips = skips.map(|s| s as i32);
         let mut alone: [AnyHitStack; 8] = Default::default();
         if active.count_ones() < path.packet_min_rays() || self.walks_alone() {
-            // A shaft's entry is made only for a tree whose rays walk alone (`Accel::shaft_entry`).
-            for_each_lane(active, |l| {
-                if entries[l].is_none() {
-                    alone[l].push(root);
-                }
-            });
-            return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips, entries);
+            for_each_lane(active, |l| alone[l].push(root));
+            return self.walk_alone(&mut alone, active, origins, dirs, t_max, &skips);
         }
         let rays = RayLanes::new(origins, dirs);
         #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
@@ -157,7 +138,7 @@ impl Accel {
             // Rays about to go on together, or to set one more subtree aside, first walk alone.
             let walk_first = if few { full } else { set_aside };
             if lanes & walk_first != 0 {
-                occluded |= self.walk_alone(alone, set_aside, origins, dirs, t_max, skips, &[None; 8]);
+                occluded |= self.walk_alone(alone, set_aside, origins, dirs, t_max, skips);
                 (set_aside, full) = (0, 0);
                 lanes &= !occluded;
             }
@@ -202,16 +183,14 @@ impl Accel {
                 }
             }
         }
-        occluded | self.walk_alone(alone, set_aside, origins, dirs, t_max, skips, &[None; 8])
+        occluded | self.walk_alone(alone, set_aside, origins, dirs, t_max, skips)
     }
 
     /// The rays of `lanes` (bit i for lane i) walk the subtrees on their stacks in `stacks`, each alone, one step
     /// of each in turn, ray i skipping group code `skips[i]`: the walks are independent, so the dependent chain of
-    /// each (node, box test, child) overlaps the others' instead of waiting alone. Ray i with an entry
-    /// (`entries[i]`, [`Accel::shaft_entry`]) first takes the entry's subtrees it enters onto its stack. Returns
-    /// the occluded ones; leaves their stacks empty.
+    /// each (node, box test, child) overlaps the others' instead of waiting alone. Returns the occluded ones;
+    /// leaves their stacks empty.
     #[inline]
-    #[allow(clippy::too_many_arguments)]
     fn walk_alone(
         &self,
         stacks: &mut [AnyHitStack; 8],
@@ -220,23 +199,12 @@ impl Accel {
         dirs: &Vec3x8,
         t_max: f32,
         skips: &[i32; 8],
-        entries: &[Option<&ShaftEntry>; 8],
     ) -> u32 {
         if lanes == 0 {
             return 0; // nothing set aside: the common end of a coherent bundle's walk
         }
         let mut rays: [Option<WideRay>; 8] = Default::default();
-        for_each_lane(lanes, |l| {
-            let ray = WideRay::new(origins.lane(l), dirs.lane(l));
-            if let Some(entry) = entries[l] {
-                let mut mask = entry.node.intersect(&ray, t_max).0;
-                if skips[l] != SKIP_NOTHING {
-                    mask &= !entry.groups.in_group(skips[l]);
-                }
-                push_entered(&mut stacks[l], &entry.node.children, mask);
-            }
-            rays[l] = Some(ray);
-        });
+        for_each_lane(lanes, |l| rays[l] = Some(WideRay::new(origins.lane(l), dirs.lane(l))));
         let (mut walking, mut occluded) = (lanes, 0);
         while walking != 0 {
             for_each_lane(walking, |l| {

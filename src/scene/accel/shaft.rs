@@ -195,7 +195,7 @@ impl Accel {
 
 impl super::node::Node8 {
     /// The children whose box lies wholly beyond one of the shaft's faces or on or behind one of its fronts.
-    pub(super) fn cleared_by(&self, shaft: &Shaft) -> u32 {
+    fn cleared_by(&self, shaft: &Shaft) -> u32 {
         let bounds = self.bounds();
         // The box corner least (most) along n: its dot product is the box's least (greatest).
         let extreme = |n: Vec3, least: bool| {

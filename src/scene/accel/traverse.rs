@@ -101,7 +101,9 @@ impl Accel {
         let mut nearest = NearestLanes::new(t_max);
         let Some(root) = self.root.filter(|_| active != 0) else { return nearest.hits() };
         let rays = RayLanes::new(&Vec3x8::splat(origin), dirs);
-        let mut stack = ArrayVec::<(Child, u32, f32x8), STACK>::new();
+        // The pending subtrees with the rays that enter them, and apart (a vector aligned in its own array, where
+        // in one tuple each push and pop copied it through unaligned temporaries) the distances they enter at.
+        let (mut stack, mut stack_t) = (ArrayVec::<(Child, u32), STACK>::new(), ArrayVec::<f32x8, STACK>::new());
         let (mut current, mut lanes) = (root, active);
         loop {
             if current.is_leaf() {
@@ -110,9 +112,11 @@ impl Accel {
                     packet.nearer_of_rays(&rays.o, &rays.d, entered, &mut nearest);
                 }
             } else {
-                // The children entered, nearest on top (an insertion sort: at most eight).
+                // The children entered, nearest on top (an insertion sort of (key, child) pairs: at most eight;
+                // each child's rays and distances kept by child, not moved by the sort).
                 let node = &self.nodes[current.first as usize];
-                let (mut order, mut n) = ([(0.0f32, Child::default(), 0u32, f32x8::ZERO); 8], 0);
+                let (mut order, mut n) = ([(0.0f32, 0usize); 8], 0);
+                let (mut entered_by, mut t_enter_by) = ([0u32; 8], [f32x8::ZERO; 8]);
                 let mut children = node.used();
                 while children != 0 {
                     let k = children.trailing_zeros() as usize;
@@ -122,24 +126,31 @@ impl Accel {
                     if entered == 0 {
                         continue;
                     }
+                    (entered_by[k], t_enter_by[k]) = (entered, t_enter);
                     let key = t_enter.as_array_ref()[entered.trailing_zeros() as usize];
                     let mut i = n;
                     while i > 0 && order[i - 1].0 < key {
                         order[i] = order[i - 1];
                         i -= 1;
                     }
-                    order[i] = (key, node.children[k], entered, t_enter);
+                    order[i] = (key, k);
                     n += 1;
                 }
                 if n > 0 {
-                    stack.extend(order[..n - 1].iter().map(|&(_, child, entered, t)| (child, entered, t)));
-                    (current, lanes) = (order[n - 1].1, order[n - 1].2);
+                    for &(_, k) in &order[..n - 1] {
+                        stack.push((node.children[k], entered_by[k]));
+                        stack_t.push(t_enter_by[k]);
+                    }
+                    let k = order[n - 1].1;
+                    (current, lanes) = (node.children[k], entered_by[k]);
                     continue;
                 }
             }
             // Next: the nearest pending subtree, with the rays that may still find something nearer in it.
             loop {
-                let Some((child, entered, t_enter)) = stack.pop() else { return nearest.hits() };
+                let (Some((child, entered)), Some(t_enter)) = (stack.pop(), stack_t.pop()) else {
+                    return nearest.hits();
+                };
                 let entered = entered & t_enter.cmp_lt(nearest.t).move_mask() as u32;
                 if entered != 0 {
                     (current, lanes) = (child, entered);
