@@ -1,8 +1,7 @@
 //! `illumlab bench`: every strategy at several budgets against a reference, written as CSV, markdown and a plot.
 
 use super::{
-    GuidingArgs, MisArgs, load_sized, parse_footprint, parse_light_selection, parse_size, parse_strategy, pass_size,
-    thread_pool,
+    GuidingArgs, MisArgs, load_sized, parse_footprint, parse_light_selection, parse_size, parse_strategy, thread_pool,
 };
 use anyhow::{Context, Result, bail};
 use illumlab::measure::{
@@ -169,24 +168,12 @@ pub fn bench(args: BenchArgs) -> Result<()> {
 
 const WALL: &str = "wall-clock seconds";
 
-/// Renders the reference with `settings` in passes of a few samples.
+/// Renders the reference with `settings`.
 fn render_reference(scene: &std::sync::Arc<Scene>, spp: u32, settings: RenderSettings) -> Reference {
     let mut renderer = Renderer::new(scene.clone(), settings);
     let mut film = Film::new(scene.camera.width, scene.camera.height);
-    let chunk = pass_size(spp, film.pixels.len());
-    let bar = indicatif::ProgressBar::new(spp as u64).with_style(
-        indicatif::ProgressStyle::with_template("reference {bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")
-            .expect("valid template"),
-    );
     let start = Instant::now();
-    let mut done = 0;
-    while done < spp {
-        let count = chunk.min(spp - done);
-        renderer.render_pass(&mut film, done, count, &|| false);
-        done += count;
-        bar.set_position(done as u64);
-    }
-    bar.finish_and_clear();
+    super::progress::render_all(&mut renderer, &mut film, spp, "reference ");
     Reference::from_film(&film, start.elapsed().as_secs_f64())
 }
 

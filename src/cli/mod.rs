@@ -2,20 +2,20 @@
 
 mod bench;
 mod probe;
+mod progress;
 mod tour;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use illumlab::guiding::{GuideSettings, Training};
 use illumlab::render::{
-    Film, Footprint, Heuristic, MisSettings, PassStats, RenderSettings, Renderer, Strategy, check_output_path,
-    write_image,
+    Film, Footprint, Heuristic, MisSettings, RenderSettings, Renderer, Strategy, check_output_path, write_image,
 };
 use illumlab::scene::{LightSelection, Scene, load_scene};
 use illumlab::session::views::View;
 use illumlab::session::worker::Budget;
 use std::path::PathBuf;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 #[derive(Parser, Debug)]
 #[command(name = "illumlab", version, about = "Monte Carlo estimators of the scattering equation: render and measure")]
@@ -317,31 +317,9 @@ fn render(args: RenderArgs) -> Result<()> {
     let shadow_walk = scene.accel().shadow_walk();
     let mut renderer = Renderer::new(std::sync::Arc::new(scene), settings);
 
-    // Passes of a few samples each: the progress bar advances between them; the result does not depend on it.
-    let chunk = pass_size(args.spp, film.pixels.len());
     let start = Instant::now();
-    let mut stats = PassStats::default();
-    let mut bar: Option<indicatif::ProgressBar> = None;
-    let mut done = 0;
-    while done < args.spp {
-        let count = chunk.min(args.spp - done);
-        stats += pool.install(|| renderer.render_pass(&mut film, done, count, &|| false));
-        done += count;
-        if bar.is_none() && start.elapsed() > Duration::from_secs(1) && done < args.spp {
-            let b = indicatif::ProgressBar::new(args.spp as u64).with_style(
-                indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} spp  {elapsed} (eta {eta})")
-                    .expect("valid template"),
-            );
-            bar = Some(b);
-        }
-        if let Some(b) = &bar {
-            b.set_position(done as u64);
-        }
-    }
+    let stats = pool.install(|| progress::render_all(&mut renderer, &mut film, args.spp, ""));
     let seconds = start.elapsed().as_secs_f64();
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
     write_image(&film, &args.output, args.exposure)?;
     if let Some(training) = renderer.training() {
         print_training(training);
@@ -388,12 +366,6 @@ pub(crate) fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool> {
         .num_threads(threads.unwrap_or(0) as usize)
         .build()
         .context("cannot start the worker threads")
-}
-
-/// Samples per pixel per pass: about 8 M samples, so a pass takes a few tenths of a second and the cost of
-/// gathering each pixel's camera-ray candidates into a packet (once per pass) is spread over many samples.
-pub(crate) fn pass_size(spp: u32, pixels: usize) -> u32 {
-    ((8_000_000 / pixels.max(1)) as u32).clamp(1, spp)
 }
 
 #[cfg(test)]

@@ -28,6 +28,13 @@ use wide::{CmpLt, f32x8};
 /// the one-sample path's values bit for bit.
 const GROUP_MIN_SAMPLES: u32 = 4;
 
+/// What a pass's rows ask of its caller: whether to stop ([`Renderer::render_pass`]), and where to report each
+/// row done.
+struct PassHooks<'a> {
+    cancelled: &'a (dyn Fn() -> bool + Sync),
+    row_done: &'a (dyn Fn(u32) + Sync),
+}
+
 /// What a render is a function of, besides the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct RenderSettings {
@@ -183,6 +190,19 @@ impl Renderer {
         count: u32,
         cancelled: &(dyn Fn() -> bool + Sync),
     ) -> PassStats {
+        self.render_pass_with_progress(film, first, count, cancelled, &|_| {})
+    }
+
+    /// [`Renderer::render_pass`], calling `row_done(n)` from the thread that rendered it each time a row has
+    /// taken `n` more samples per pixel (a pass that learns calls it once per row for each of its parts).
+    pub fn render_pass_with_progress(
+        &mut self,
+        film: &mut Film,
+        first: u32,
+        count: u32,
+        cancelled: &(dyn Fn() -> bool + Sync),
+        row_done: &(dyn Fn(u32) + Sync),
+    ) -> PassStats {
         let end = first + count;
         let mut stats = PassStats::default();
         let mut s = first;
@@ -197,7 +217,8 @@ impl Renderer {
             if !keep {
                 stop = stop.min(training_end);
             }
-            let (part, records) = self.render_range(film, s, stop - s, learn, keep, cancelled);
+            let hooks = PassHooks { cancelled, row_done };
+            let (part, records) = self.render_range(film, s, stop - s, learn, keep, &hooks);
             stats += part;
             if cancelled() {
                 break;
@@ -219,7 +240,7 @@ impl Renderer {
         count: u32,
         learn: bool,
         keep: bool,
-        cancelled: &(dyn Fn() -> bool + Sync),
+        hooks: &PassHooks,
     ) -> (PassStats, Vec<Vec<GuideRecord>>) {
         let width = film.width;
         assert_eq!((film.width, film.height), self.size, "film and camera sizes differ");
@@ -229,7 +250,7 @@ impl Renderer {
             .map(|(y, row)| {
                 let mut stats = PassStats::default();
                 let mut records = Vec::new();
-                if cancelled() {
+                if (hooks.cancelled)() {
                     return (stats, records);
                 }
                 let cpu = ThreadTime::now();
@@ -281,6 +302,7 @@ impl Renderer {
                 stats.rays = rays;
                 stats.samples = count as u64 * width as u64;
                 stats.cpu = cpu.elapsed();
+                (hooks.row_done)(count);
                 (stats, records)
             })
             .collect::<Vec<_>>()
