@@ -1,7 +1,9 @@
 //! Uniform sampling of the spherical triangle that a planar triangle subtends (Arvo 1995, "Stratified sampling
 //! of spherical triangles"; after pbrt-v4's `SampleSphericalTriangle`). Computed in f64: the construction
-//! subtracts nearly equal angles for small triangles.
+//! subtracts nearly equal angles for small triangles. Its sines, cosines and arcsines are `math::trig`'s, which
+//! the four-lane copy (`super::spherical_triangle_lanes`) computes four at a time, bit for bit.
 
+use crate::math::{asin_f64, sin_cos_f64};
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::PI;
 
@@ -42,8 +44,8 @@ pub fn sample_spherical_triangle(u: Vec2, p: Vec3, a: Vec3, b: Vec3, c: Vec3) ->
     }
     // The sub-triangle of area A' = u₀ A fixes the point c' on the arc a→c ...
     let ap_pi = PI + f64::from(u.x) * (area_pi - PI);
-    let (sin_alpha, cos_alpha) = alpha.sin_cos();
-    let (sin_ap, cos_ap) = ap_pi.sin_cos();
+    let (sin_alpha, cos_alpha) = sin_cos_f64(alpha);
+    let (sin_ap, cos_ap) = sin_cos_f64(ap_pi);
     let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
     let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
     let k1 = cos_phi + cos_alpha;
@@ -69,9 +71,9 @@ pub fn spherical_triangle_pdf(solid_angle: f32) -> f32 {
 /// The angle between unit vectors, accurate also when they are nearly parallel or opposite.
 fn angle_between(v1: DVec3, v2: DVec3) -> f64 {
     if v1.dot(v2) < 0.0 {
-        PI - 2.0 * ((v1 + v2).length() / 2.0).clamp(-1.0, 1.0).asin()
+        PI - 2.0 * asin_f64(((v1 + v2).length() / 2.0).clamp(-1.0, 1.0))
     } else {
-        2.0 * ((v2 - v1).length() / 2.0).clamp(-1.0, 1.0).asin()
+        2.0 * asin_f64(((v2 - v1).length() / 2.0).clamp(-1.0, 1.0))
     }
 }
 

@@ -1,11 +1,11 @@
 //! [`sample_spherical_triangle`] for eight directions at once, as two f64x4 halves (Arvo 1995, as there). The
 //! normalisations, cross and dot products, divisions and square roots run in f64x4 in the scalar code's order
-//! (glam's `DVec3` formulas, no fused multiply-adds); the transcendental functions (the three angles' `asin`, the
-//! two `sin_cos`) are the scalar code's calls, lane by lane. Each lane gets what `sample_spherical_triangle` gives
-//! it, bit for bit.
+//! (glam's `DVec3` formulas, no fused multiply-adds), and so do the transcendental functions (the three angles'
+//! `asin`, the two `sin_cos`: `math::trig`'s, which the scalar code computes in lane 0). Each lane gets what
+//! `sample_spherical_triangle` gives it, bit for bit.
 
 use super::sample_spherical_triangle;
-use crate::math::for_each_lane;
+use crate::math::{asin_f64_lanes, for_each_lane, sin_cos_f64_lanes};
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::PI;
 use wide::{CmpEq, CmpGt, CmpLt, f64x4};
@@ -52,15 +52,15 @@ fn sample_four(u: &[Vec2; 4], [a, b, c]: [DVec3x4; 3], lanes: u32) -> [Option<Ve
     let mut valid = lanes & !(degenerate.move_mask() as u32);
     let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
     // The spherical triangle's angles at its vertices; its area is α + β + γ − π.
-    let alpha = angle_between(n_ab, -n_ca, valid);
-    let beta = angle_between(n_bc, -n_ab, valid);
-    let gamma = angle_between(n_ca, -n_bc, valid);
+    let alpha = angle_between(n_ab, -n_ca);
+    let beta = angle_between(n_bc, -n_ab);
+    let gamma = angle_between(n_ca, -n_bc);
     let area_pi = alpha + beta + gamma;
     valid &= (area_pi - f64x4::splat(PI)).cmp_gt(zero).move_mask() as u32;
     // The sub-triangle of area A' = u₀ A fixes the point c' on the arc a→c ...
     let u_x = f64x4::new(u.map(|u| f64::from(u.x)));
     let ap_pi = f64x4::splat(PI) + u_x * (area_pi - f64x4::splat(PI));
-    let ((sin_alpha, cos_alpha), (sin_ap, cos_ap)) = (sin_cos(alpha, valid), sin_cos(ap_pi, valid));
+    let ((sin_alpha, cos_alpha), (sin_ap, cos_ap)) = (sin_cos_f64_lanes(alpha), sin_cos_f64_lanes(ap_pi));
     let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
     let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
     let k1 = cos_phi + cos_alpha;
@@ -83,25 +83,13 @@ fn sample_four(u: &[Vec2; 4], [a, b, c]: [DVec3x4; 3], lanes: u32) -> [Option<Ve
 }
 
 /// `angle_between` of `spherical_triangle.rs` per lane: `π − 2 asin(|v₁ + v₂|/2)` where v₁·v₂ < 0, else
-/// `2 asin(|v₂ − v₁|/2)`; the `asin` of the lanes of `lanes` only (the others are 0).
+/// `2 asin(|v₂ − v₁|/2)`.
 #[inline(always)]
-fn angle_between(v1: DVec3x4, v2: DVec3x4, lanes: u32) -> f64x4 {
+fn angle_between(v1: DVec3x4, v2: DVec3x4) -> f64x4 {
     let opposed = v1.dot(v2).cmp_lt(f64x4::ZERO);
     let half_chord = opposed.blend((v1 + v2).length(), (v2 - v1).length()) / f64x4::splat(2.0);
-    let half_chord = clamp_unit(half_chord).to_array();
-    let mut asin = [0.0; 4];
-    for_each_lane(lanes, |l| asin[l] = half_chord[l].asin());
-    let twice = f64x4::splat(2.0) * f64x4::new(asin);
+    let twice = f64x4::splat(2.0) * asin_f64_lanes(clamp_unit(half_chord));
     opposed.blend(f64x4::splat(PI) - twice, twice)
-}
-
-/// `(sin x, cos x)` of the lanes of `lanes` (0 and 0 elsewhere), by `f64::sin_cos`.
-#[inline(always)]
-fn sin_cos(x: f64x4, lanes: u32) -> (f64x4, f64x4) {
-    let x = x.to_array();
-    let (mut sin, mut cos) = ([0.0; 4], [0.0; 4]);
-    for_each_lane(lanes, |l| (sin[l], cos[l]) = x[l].sin_cos());
-    (f64x4::new(sin), f64x4::new(cos))
 }
 
 /// `f64::clamp(x, −1, 1)` per lane: NaN stays NaN.
