@@ -16,7 +16,7 @@ pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};
 pub use phong_polygon::phong_polygon_moment;
 pub use polygon::lambert_polygon_irradiance;
 pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes, hash_ray, mix64};
-pub use trig::{asin_f64, asin_f64_lanes, sin_cos, sin_cos_f64, sin_cos_f64_lanes, sin_cos_lanes};
+pub use trig::{acos_f64_lanes, asin_f64, asin_f64_lanes, sin_cos, sin_cos_f64, sin_cos_f64_lanes, sin_cos_lanes};
 pub use vec3x8::Vec3x8;
 
 /// Reflects `w` about the unit normal `n`: ω_r = 2 (n·ω) n − ω (the lecture's mirror direction).

@@ -9,8 +9,9 @@
 
 use super::spherical_triangle::{MAX_SPHERICAL_SAMPLE_AREA, MIN_SPHERICAL_SAMPLE_AREA};
 use super::{sample_spherical_triangle, sample_spherical_triangle_lanes, spherical_triangle_area};
-use crate::math::{SampleRng, for_each_lane};
+use crate::math::{SampleRng, acos_f64_lanes, for_each_lane};
 use glam::{DVec3, Vec2, Vec3};
+use wide::f64x4;
 
 /// Rejection is used only where it accepts at least this fraction of trials; elsewhere the caller samples area.
 pub const MIN_ACCEPTANCE: f32 = 0.05;
@@ -133,11 +134,16 @@ pub fn projected_solid_angle_f64(n: DVec3, rel: [DVec3; 3]) -> f64 {
     if len < 3 {
         return 0.0;
     }
+    // The edges' angles Θ_i = acos(γ̂_i·γ̂_{i+1}), all of them in one four-lane `acos`.
+    let unit = poly.map(DVec3::normalize_or_zero);
+    let mut cosines = [1.0; 4];
+    for i in 0..len {
+        cosines[i] = unit[i].dot(unit[(i + 1) % len]).clamp(-1.0, 1.0);
+    }
+    let theta = acos_f64_lanes(f64x4::new(cosines)).to_array();
     let mut sum = 0.0;
     for i in 0..len {
-        let (u, v) = (poly[i].normalize_or_zero(), poly[(i + 1) % len].normalize_or_zero());
-        let theta = u.dot(v).clamp(-1.0, 1.0).acos();
-        sum += theta * n.dot(u.cross(v).normalize_or_zero());
+        sum += theta[i] * n.dot(unit[i].cross(unit[(i + 1) % len]).normalize_or_zero());
     }
     let result = 0.5 * sum.abs();
     if result.is_finite() { result } else { 0.0 }
