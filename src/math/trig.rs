@@ -103,7 +103,7 @@ mod tests {
     /// (and the ends): sin, cos, asin and acos within 2 ULP of the f64 library's, asin(±1) = ±π/2, asin(0) = 0,
     /// acos(1) = 0, acos(−1) = π and acos(0) = π/2 exactly; one lane gives what four give, bit for bit.
     #[test]
-    fn f64_sin_cos_and_asin_are_within_a_few_ulp_and_lanes_agree() {
+    fn f64_sin_cos_asin_and_acos_are_within_two_ulp_and_lanes_agree() {
         let n = 1 << 20;
         let (mut worst_trig, mut worst_asin, mut worst_acos): (f64, f64, f64) = (0.0, 0.0, 0.0);
         for k in 0..n {
