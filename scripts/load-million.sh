@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Loading a big mesh: writes a rippled grid of 1 002 528 triangles (a 37.7 MB OBJ) and times the whole
 # `illumlab render` process on it at 4×4 pixels and 1 spp (so nearly all of it is parsing the OBJ and building the
-# BVH), ROUNDS times; prints each run's wall seconds and peak RSS, and the peak RSS per triangle.
+# BVH), ROUNDS times; prints each run's wall seconds and peak RSS, and the peak RSS per triangle. Each round runs
+# three loads, in a tree cache of its own (scene::TreeCache, under the script's temporary folder): `built` with the
+# cache off, `stored` (built, then written to the empty cache) and `read` (the tree read back from it).
 # Usage: scripts/load-million.sh [ROUNDS] [BINARY ...]   (default 5, target/release/illumlab; several binaries
 # run in turn, round by round)
 set -euo pipefail
@@ -33,9 +35,14 @@ EOF
 echo "CPU: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; OBJ $(du -m "$work/million.obj" | cut -f1) MB"
 for r in $(seq "$rounds"); do
   for b in "${binaries[@]}"; do
-    /usr/bin/time -f "%e %M" -o "$work/time" "$b" render "$work/million.obj" --strategy emitter --spp 1 --size 4x4 \
-      -o "$work/out.exr" >/dev/null 2>&1
-    read -r seconds kb <"$work/time"
-    echo "$b round $r: $seconds s, peak RSS $((kb / 1024)) MiB ($((kb * 1024 / 1002528)) bytes per triangle)"
+    rm -rf "$work/cache"
+    for load in built stored read; do
+      cache=on
+      [ "$load" = built ] && cache=off
+      ILLUMLAB_CACHE=$cache XDG_CACHE_HOME="$work/cache" /usr/bin/time -f "%e %M" -o "$work/time" \
+        "$b" render "$work/million.obj" --strategy emitter --spp 1 --size 4x4 -o "$work/out.exr" >/dev/null 2>&1
+      read -r seconds kb <"$work/time"
+      echo "$b round $r, $load: $seconds s, peak RSS $((kb / 1024)) MiB ($((kb * 1024 / 1002528)) bytes per triangle)"
+    done
   done
 done

@@ -8,8 +8,11 @@ the scene with the same change. `emitter` is Mitsuba's `direct` with emitter_sam
 emitter_samples=1, bsdf_samples=1 (both power-heuristic MIS of one light and one BSDF sample).
 
 Timed: illumlab's whole `render` process (load, BVH, render, EXR written) against Mitsuba's warm render (the
-second `mi.render` of the scene in one process, its kernels compiled; scene loading not counted), each ROUNDS
-times, in turn. The mean radiance of both images is printed: the same integral, so they must agree.
+second `mi.render` of the scene in one process, its kernels compiled and cached; scene loading not counted), each
+ROUNDS times, in turn. Both are warm: Mitsuba's kernels compiled (Dr.Jit keeps them on disk), illumlab's tree in
+its cache (scene::TreeCache; a mesh of 16 384 triangles or more, here the knot), each filled by an untimed first
+run. illumlab's process with the tree built (its cache off) is timed too, in the same rounds. The mean radiance of
+both images is printed: the same integral, so they must agree.
 """
 
 import os
@@ -130,12 +133,14 @@ def render_mitsuba(scene, spp, seed):
     return time.perf_counter() - start, float(arr[..., :3].mean())
 
 
-def render_illumlab(binary, toml, strategy, size, spp, seed, out):
-    """Seconds of the whole `illumlab render` process and the image's mean radiance."""
+def render_illumlab(binary, toml, strategy, size, spp, seed, out, cache):
+    """Seconds of the whole `illumlab render` process and the image's mean radiance; `cache` is the folder of
+    illumlab's caches, or None to build the tree."""
     cmd = [binary, "render", toml, "--strategy", strategy, "--spp", str(spp), "--size", f"{size}x{size}",
            "--seed", str(seed), "-o", out]
+    env = dict(os.environ, XDG_CACHE_HOME=cache or "", ILLUMLAB_CACHE="on" if cache else "off")
     start = time.perf_counter()
-    subprocess.run(cmd, check=True, capture_output=True)
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
     seconds = time.perf_counter() - start
     return seconds, float(np.array(mi.Bitmap(out))[..., :3].mean())
 
@@ -147,28 +152,30 @@ def main():
           f"Dr.Jit {dr.__version__}")
     print()
     print("| scene | strategy | illumlab whole process, s | Mitsuba warm render, s | illumlab faster by | "
-          "each round's ratio, range | mean radiance illumlab / Mitsuba |")
-    print("|---|---|---:|---:|---:|---:|---|")
+          "each round's ratio, range | tree built: illumlab s, faster by | mean radiance illumlab / Mitsuba |")
+    print("|---|---|---:|---:|---:|---:|---:|---|")
     for scene_path in scenes:
         name = os.path.basename(scene_path).removesuffix(".toml")
         with tempfile.TemporaryDirectory() as work:
             toml = diffuse_copy(scene_path, work)
             for strategy in strategies:
                 scene = mitsuba_scene(toml, size, spp, strategy, work)
+                out, cache = os.path.join(work, "illumlab.exr"), os.path.join(work, "cache")
                 render_mitsuba(scene, spp, 0)  # compiles the kernels: what follows is warm
-                times = {"illumlab": [], "mitsuba": []}
+                render_illumlab(binary, toml, strategy, size, spp, 0, out, cache)  # fills the tree cache
+                times = {"illumlab": [], "mitsuba": [], "built": []}
                 means = {}
                 for r in range(rounds):
-                    out = os.path.join(work, "illumlab.exr")
-                    t, means["illumlab"] = render_illumlab(binary, toml, strategy, size, spp, r + 1, out)
+                    t, means["illumlab"] = render_illumlab(binary, toml, strategy, size, spp, r + 1, out, cache)
                     times["illumlab"].append(t)
                     t, means["mitsuba"] = render_mitsuba(scene, spp, r + 1)
                     times["mitsuba"].append(t)
-                il, mt = (sorted(times[k])[rounds // 2] for k in ("illumlab", "mitsuba"))
+                    times["built"].append(render_illumlab(binary, toml, strategy, size, spp, r + 1, out, None)[0])
+                il, mt, built = (sorted(times[k])[rounds // 2] for k in ("illumlab", "mitsuba", "built"))
                 # Each round's two runs follow each other, so their ratio shares the machine's speed of the moment.
                 ratios = [m / i for i, m in zip(times["illumlab"], times["mitsuba"])]
                 print(f"| {name} | {strategy} | {il:.3f} | {mt:.3f} | {mt / il:.2f}x | "
-                      f"{min(ratios):.2f}–{max(ratios):.2f}x | "
+                      f"{min(ratios):.2f}–{max(ratios):.2f}x | {built:.3f}, {mt / built:.2f}x | "
                       f"{means['illumlab']:.4f} / {means['mitsuba']:.4f} |", flush=True)
 
 

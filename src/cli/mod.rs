@@ -315,6 +315,8 @@ fn render(args: RenderArgs) -> Result<()> {
     };
     let mut film = Film::new(scene.camera.width, scene.camera.height);
     let shadow_walk = scene.accel().shadow_walk();
+    // A large mesh's tree read back from the cache rather than built (`scene::TreeCache`): a faster load.
+    let tree = if scene.accel().from_cache() { ", tree read from the cache" } else { "" };
     let mut renderer = Renderer::new(std::sync::Arc::new(scene), settings);
 
     let start = Instant::now();
@@ -325,13 +327,14 @@ fn render(args: RenderArgs) -> Result<()> {
         print_training(training);
     }
     println!(
-        "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped, shadow rays in {} -> {}",
+        "{} spp, {:.3} s, {:.2} M samples/s, {:.2} M rays/s, {} non-finite samples dropped, shadow rays in {}{} -> {}",
         args.spp,
         seconds,
         stats.samples as f64 / seconds / 1e6,
         stats.rays as f64 / seconds / 1e6,
         stats.non_finite,
         shadow_walk,
+        tree,
         args.output.display()
     );
     Ok(())

@@ -211,13 +211,10 @@ pub fn cache_path(folder: &Path, scene: &Scene, spp: u32, footprint: Footprint) 
     folder.join(format!("{name}-{key:016x}-{spp}spp-{}.exr", footprint.name()))
 }
 
-/// The default cache folder: `$XDG_CACHE_HOME/illumlab/references`, else `~/.cache/illumlab/references`.
+/// The default cache folder: `references` in illumlab's cache folder (`$XDG_CACHE_HOME/illumlab`, else
+/// `~/.cache/illumlab`).
 pub fn default_cache_folder() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CACHE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(base.join("illumlab").join("references"))
+    crate::scene::user_cache_folder().map(|folder| folder.join("references"))
 }
 
 /// Loads a cached reference if one exists for this scene, spp and footprint.

@@ -18,8 +18,8 @@ mod tile_lights;
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
 pub use accel::{
-    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, VectorPath, has_avx512,
-    vector_path,
+    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, TreeCache, VectorPath,
+    has_avx512, user_cache_folder, vector_path,
 };
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
@@ -133,7 +133,8 @@ impl Scene {
             warnings.push(format!("{} degenerate (zero-area) triangle(s) ignored", degenerate.len()));
         }
         let groups = convex::convex_emitter_groups(&kept, |i| materials[kept_ids[i] as usize].is_emissive());
-        let (accel, order) = Accel::build(&kept, &groups);
+        // A large mesh's tree is read back from the cache the environment names, if it holds one for this input.
+        let (accel, order) = Accel::build_cached(&kept, &groups, TreeCache::from_env());
         // Each triangle's normal, area and error bounds, worked out in the tree's order on all cores (worked out
         // in input order beside the build, then reordered, they took a second copy: 72 MB for 1M triangles).
         let triangles: Vec<Triangle> =

@@ -10,6 +10,7 @@
 mod avx512;
 mod blockers;
 mod build;
+mod cache;
 mod frustum;
 mod node;
 mod packet;
@@ -20,6 +21,7 @@ mod traverse;
 mod vectors;
 
 pub use blockers::ShadowBlockers;
+pub use cache::{TreeCache, user_cache_folder};
 pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
@@ -46,6 +48,8 @@ pub struct Accel {
     root: Option<Child>,
     /// The wide levels on the tree's longest path (0 for a leaf or no tree).
     depth: usize,
+    /// Read from a [`TreeCache`] rather than built.
+    from_cache: bool,
 }
 
 /// The group a shadow ray skips when it skips none (see [`Accel::build`]).
@@ -108,13 +112,14 @@ impl Accel {
     pub fn build(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> (Self, Vec<u32>) {
         assert_eq!(positions.len(), groups.len(), "one group (or none) per triangle");
         if positions.is_empty() {
-            let empty = Self { nodes: Vec::new(), groups: Vec::new(), packets: Vec::new(), root: None, depth: 0 };
+            let (nodes, groups, packets) = (Vec::new(), Vec::new(), Vec::new());
+            let empty = Self { nodes, groups, packets, root: None, depth: 0, from_cache: false };
             return (empty, Vec::new());
         }
         let built = build::build(positions, groups);
         let (nodes, groups, packets, root, depth) =
             (built.nodes, built.groups, built.packets, Some(built.root), built.depth);
-        (Self { nodes, groups, packets, root, depth }, built.order)
+        (Self { nodes, groups, packets, root, depth, from_cache: false }, built.order)
     }
 
     /// The groups (see [`Accel::build`]) that some subtree holds apart: the only ones worth skipping.

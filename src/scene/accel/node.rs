@@ -29,7 +29,9 @@ impl Child {
     }
 }
 
-#[derive(Clone, Debug)]
+/// Plain data in C's layout, so that the tree cache (`super::cache`) reads nodes straight into place.
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub(super) struct Node8 {
     /// min x, min y, min z, max x, max y, max z of the children's boxes; an unused lane holds the empty box
     /// (min = +∞, max = −∞), which no ray enters.
@@ -37,11 +39,14 @@ pub(super) struct Node8 {
     pub children: [Child; 8],
     /// Bit i set when lane i holds a child.
     used: u32,
+    /// Up to the 32-byte alignment of the boxes: 288 bytes in all.
+    _pad: [u32; 7],
 }
 
 /// Per child of a node, the group all its triangles belong to (see [`super::Accel::build`]), or [`NO_GROUP`].
 /// Kept beside the nodes, not in them: only a ray that skips a group reads it, and nodes stay 288 bytes.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(transparent)]
 pub(super) struct ChildGroups(i32x8);
 
 /// A child whose triangles are not all in one group.
@@ -69,7 +74,8 @@ impl Node8 {
         }
         let [x0, y0, z0] = lo.map(f32x8::new);
         let [x1, y1, z1] = hi.map(f32x8::new);
-        Self { bounds: [x0, y0, z0, x1, y1, z1], children: kids, used: (1u32 << children.len()) - 1 }
+        let used = (1u32 << children.len()) - 1;
+        Self { bounds: [x0, y0, z0, x1, y1, z1], children: kids, used, _pad: [0; 7] }
     }
 
     /// The lanes whose box the ray `o + t·d` overlaps for some `0 ≤ t ≤ t_max` (bit i for child i), and the
