@@ -638,25 +638,29 @@ fn bare_obj_renders_with_an_automatic_camera() {
     assert!(img.as_raw().iter().any(|&b| b > 0), "the bare OBJ rendered black: the camera misses the geometry?");
 }
 
-/// A large mesh's tree is built and stored on the first load and read back on the next (`scene::TreeCache`, in a
-/// cache folder of the test's own); the image is the same byte for byte either way, and with the cache off.
+/// A large mesh's tree and its OBJ's geometry are stored on the first load and read back on the next
+/// (`scene::TreeCache`, `scene::obj_cache`, in a cache folder of the test's own); the image is the same byte for
+/// byte either way, and with the caches off.
 #[test]
 fn a_large_mesh_tree_is_read_back_from_the_cache() {
     let dir = TempDir::new().unwrap();
-    // A grid of 92 × 92 squares (16 928 triangles, above the cache's 16 384) under a square light.
+    // A grid of 92 × 92 squares (16 928 triangles, above the tree cache's 16 384) under a square light, with
+    // texture coordinates and normals as a scanner writes them (1.3 MB, above the OBJ cache's 1 MiB).
     let n = 92;
     let mut obj = String::from("mtllib m.mtl\nusemtl grey\n");
     for j in 0..=n {
         for i in 0..=n {
-            obj += &format!("v {} {} 0\n", i as f32 / n as f32, j as f32 / n as f32);
+            let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+            obj += &format!("v {u:.6} {v:.6} 0.000000\nvt {u:.6} {v:.6}\nvn 0 0 1\n");
         }
     }
     for j in 0..n {
         for i in 0..n {
-            let a = j * (n + 1) + i + 1;
-            obj += &format!("f {a} {} {}\nf {a} {} {}\n", a + 1, a + n + 2, a + n + 2, a + n + 1);
+            let [a, b, c, d] = [0, 1, n + 2, n + 1].map(|k| j * (n + 1) + i + 1 + k);
+            obj += &format!("f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}\nf {a}/{a}/{a} {c}/{c}/{c} {d}/{d}/{d}\n");
         }
     }
+    assert!(obj.len() > 1 << 20, "{} bytes", obj.len());
     obj += "usemtl light\nv 0.4 0.4 1\nv 0.6 0.4 1\nv 0.6 0.6 1\nv 0.4 0.6 1\nf -1 -2 -3 -4\n";
     fs::write(dir.path().join("grid.obj"), obj).unwrap();
     fs::write(dir.path().join("m.mtl"), "newmtl grey\nKd 0.5 0.5 0.5\nnewmtl light\nKd 0 0 0\nKe 4 4 4\n").unwrap();
@@ -674,8 +678,10 @@ fn a_large_mesh_tree_is_read_back_from_the_cache() {
     let (off_read, off) = render("off.exr", "off");
     assert!(!first_read && second_read && !off_read, "read from the cache: {first_read}, {second_read}, {off_read}");
     assert!(first == second && second == off, "the same image whether the tree was built or read");
-    let entries: Vec<_> = fs::read_dir(cache.join("illumlab").join("trees")).unwrap().collect();
-    assert_eq!(entries.len(), 1, "one tree stored, no partial file left");
+    for folder in ["trees", "objs"] {
+        let entries = fs::read_dir(cache.join("illumlab").join(folder)).unwrap().count();
+        assert_eq!(entries, 1, "one entry in {folder}, no partial file left");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@ mod accel;
 mod bundled;
 mod camera;
 mod convex;
+mod disk_cache;
 mod emitter_tree;
 mod emitters;
 mod error;
@@ -13,18 +14,20 @@ mod load;
 mod material;
 mod mtl;
 mod obj;
+mod obj_cache;
 mod tile_lights;
 
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
 pub use accel::{
     Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, TreeCache, VectorPath,
-    has_avx512, user_cache_folder, vector_path,
+    has_avx512, vector_path,
 };
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
 pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
+pub use disk_cache::{DiskCache, user_cache_folder};
 pub use emitter_tree::EmitterTree;
 pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection};
 pub use error::SceneError;

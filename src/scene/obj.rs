@@ -13,6 +13,7 @@
 //! - a name (`usemtl`, `mtllib`, `o`, `g`) is the rest of the line after the word, trimmed.
 
 use super::SceneError;
+use super::obj_cache::ObjCache;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -41,6 +42,7 @@ pub(super) struct ObjGeometry {
     pub unknown_materials: Vec<String>,
 }
 
+#[derive(Debug)]
 pub(super) struct Run {
     pub first: usize,
     pub object: String,
@@ -49,7 +51,8 @@ pub(super) struct Run {
 }
 
 /// A statement settled in file order, after the chunks are read.
-enum Statement<'a> {
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Statement<'a> {
     Object(&'a str),
     Mtllib(&'a str),
     Usemtl(&'a str),
@@ -72,42 +75,79 @@ struct Chunk<'a> {
 }
 
 /// Reads an OBJ file's text; `load_mtl` reads an `mtllib` line's file (a path relative to the OBJ's folder) and is
-/// called in file order. Errors name `path`, the line and what is wrong.
+/// called in file order. Errors name `path`, the line and what is wrong. A large text's geometry is read back from
+/// the cache the environment names ([`ObjCache`]), if it holds this text's.
 pub(super) fn read_obj(
     text: &str,
     path: &Path,
     load_mtl: impl FnMut(&str) -> Result<Vec<tobj::Material>, SceneError>,
 ) -> Result<ObjGeometry, SceneError> {
-    let size = text.len().div_ceil(4 * rayon::current_num_threads()).max(MIN_CHUNK);
-    read_in_pieces(text, path, size, load_mtl)
+    let parsed = match ObjCache::from_env().filter(|_| text.len() >= ObjCache::MIN_BYTES) {
+        Some(cache) => {
+            let key = ObjCache::key(text);
+            match cache.load(key, text) {
+                Some(parsed) => parsed,
+                None => {
+                    let parsed = parse(text, path)?;
+                    // A failure to store only loses the time it would have saved.
+                    let _ = cache.store(key, &parsed, text);
+                    parsed
+                }
+            }
+        }
+        None => parse(text, path)?,
+    };
+    settle(parsed, load_mtl)
 }
 
-/// [`read_obj`] with the text cut into pieces of about `size` bytes.
+/// Reads the text's geometry and statements on all cores, without settling the statements.
+pub(super) fn parse<'a>(text: &'a str, path: &Path) -> Result<Parsed<'a>, SceneError> {
+    let size = text.len().div_ceil(4 * rayon::current_num_threads()).max(MIN_CHUNK);
+    parse_in_pieces(text, path, size)
+}
+
+/// An OBJ text's geometry and its statements, before the statements are settled (the MTL files read, the runs of
+/// objects and materials found).
+pub(super) struct Parsed<'a> {
+    /// As [`ObjGeometry`]'s.
+    pub positions: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    /// The statements in file order, each with the number of triangles above it.
+    pub statements: Vec<(usize, Statement<'a>)>,
+}
+
+/// [`read_obj`] with the text cut into pieces of about `size` bytes, and no cache.
+#[cfg(test)]
 fn read_in_pieces(
     text: &str,
     path: &Path,
     size: usize,
-    mut load_mtl: impl FnMut(&str) -> Result<Vec<tobj::Material>, SceneError>,
+    load_mtl: impl FnMut(&str) -> Result<Vec<tobj::Material>, SceneError>,
 ) -> Result<ObjGeometry, SceneError> {
+    settle(parse_in_pieces(text, path, size)?, load_mtl)
+}
+
+/// Reads the text cut into pieces of about `size` bytes, each on its own, then joins them.
+fn parse_in_pieces<'a>(text: &'a str, path: &Path, size: usize) -> Result<Parsed<'a>, SceneError> {
     let error = |line: usize, message: String| SceneError::Obj {
         path: path.to_path_buf(),
         message: format!("line {line}: {message}"),
     };
     let pieces = cut(text, size);
-    let chunks: Vec<Chunk> = pieces.par_iter().map(|piece| Chunk::read(piece)).collect();
+    let mut chunks: Vec<Chunk> = pieces.par_iter().map(|piece| Chunk::read(piece)).collect();
 
     // The first line, position and triangle of each chunk.
     let mut first_line = Vec::with_capacity(chunks.len());
     let mut first_position = Vec::with_capacity(chunks.len());
-    let mut first_triangle = Vec::with_capacity(chunks.len());
     let (mut line, mut position, mut triangle) = (1, 0, 0);
-    for chunk in &chunks {
+    let mut statements = Vec::new();
+    for chunk in &mut chunks {
         if let Some((at, message)) = &chunk.error {
             return Err(error(line + at, message.clone()));
         }
         first_line.push(line);
         first_position.push(position);
-        first_triangle.push(triangle);
+        statements.extend(chunk.statements.drain(..).map(|(at, statement)| (triangle + at, statement)));
         line += chunk.lines;
         position += chunk.positions.len();
         triangle += chunk.triangles.len();
@@ -116,46 +156,7 @@ fn read_in_pieces(
         return Err(error(line, format!("{position} vertices: at most {MAX_POSITIONS} are read")));
     }
 
-    // The statements, in file order.
-    let mut geometry = ObjGeometry {
-        positions: Vec::with_capacity(position),
-        triangles: Vec::with_capacity(triangle),
-        runs: vec![Run { first: 0, object: "unnamed".into(), material: None }],
-        materials: Vec::new(),
-        unknown_materials: Vec::new(),
-    };
-    let mut material_index: HashMap<String, usize> = HashMap::new();
-    for (chunk, &first) in chunks.iter().zip(&first_triangle) {
-        for (at, statement) in &chunk.statements {
-            let last = geometry.runs.last().expect("a run");
-            let (mut object, mut material) = (last.object.as_str(), last.material);
-            match *statement {
-                Statement::Object(name) => object = if name.is_empty() { "unnamed" } else { name },
-                Statement::Mtllib(file) => {
-                    for m in load_mtl(file)? {
-                        material_index.insert(m.name.clone(), geometry.materials.len());
-                        geometry.materials.push(m);
-                    }
-                }
-                Statement::Usemtl(name) => {
-                    material = material_index.get(name).copied();
-                    if material.is_none() && !geometry.unknown_materials.iter().any(|u| u == name) {
-                        geometry.unknown_materials.push(name.to_string());
-                    }
-                }
-            }
-            if (object, material) != (last.object.as_str(), last.material) {
-                let run = Run { first: first + at, object: object.to_string(), material };
-                match geometry.runs.last_mut() {
-                    Some(last) if last.first == run.first => *last = run,
-                    _ => geometry.runs.push(run),
-                }
-            }
-        }
-    }
-
     // The relative corners, then every corner's bounds (a corner past the last vertex names its line).
-    let mut chunks = chunks;
     chunks.par_iter_mut().zip(&first_position).for_each(|(chunk, &first)| {
         for &slot in &chunk.relative {
             let corner = &mut chunk.triangles[slot / 3][slot % 3];
@@ -172,9 +173,54 @@ fn read_in_pieces(
             format!("'{}' refers to a vertex the file does not have (it has {position})", text.trim()),
         ));
     }
+    let mut parsed =
+        Parsed { positions: Vec::with_capacity(position), triangles: Vec::with_capacity(triangle), statements };
     for chunk in chunks {
-        geometry.positions.extend_from_slice(&chunk.positions);
-        geometry.triangles.extend_from_slice(&chunk.triangles);
+        parsed.positions.extend_from_slice(&chunk.positions);
+        parsed.triangles.extend_from_slice(&chunk.triangles);
+    }
+    Ok(parsed)
+}
+
+/// The statements in file order: the MTL files they name read through `load_mtl`, the runs of one object and
+/// one material, the materials no `mtllib` above their `usemtl` defines.
+pub(super) fn settle(
+    parsed: Parsed,
+    mut load_mtl: impl FnMut(&str) -> Result<Vec<tobj::Material>, SceneError>,
+) -> Result<ObjGeometry, SceneError> {
+    let mut geometry = ObjGeometry {
+        positions: parsed.positions,
+        triangles: parsed.triangles,
+        runs: vec![Run { first: 0, object: "unnamed".into(), material: None }],
+        materials: Vec::new(),
+        unknown_materials: Vec::new(),
+    };
+    let mut material_index: HashMap<String, usize> = HashMap::new();
+    for (first, statement) in parsed.statements {
+        let last = geometry.runs.last().expect("a run");
+        let (mut object, mut material) = (last.object.as_str(), last.material);
+        match statement {
+            Statement::Object(name) => object = if name.is_empty() { "unnamed" } else { name },
+            Statement::Mtllib(file) => {
+                for m in load_mtl(file)? {
+                    material_index.insert(m.name.clone(), geometry.materials.len());
+                    geometry.materials.push(m);
+                }
+            }
+            Statement::Usemtl(name) => {
+                material = material_index.get(name).copied();
+                if material.is_none() && !geometry.unknown_materials.iter().any(|u| u == name) {
+                    geometry.unknown_materials.push(name.to_string());
+                }
+            }
+        }
+        if (object, material) != (last.object.as_str(), last.material) {
+            let run = Run { first, object: object.to_string(), material };
+            match geometry.runs.last_mut() {
+                Some(last) if last.first == run.first => *last = run,
+                _ => geometry.runs.push(run),
+            }
+        }
     }
     Ok(geometry)
 }

@@ -4,34 +4,27 @@
 //! kernels on disk the same way.
 //!
 //! An entry is found by a 128-bit XXH3 hash of everything the build reads: the triangles' positions and groups,
-//! this format's version and the identity of the program (its executable's path, size and modification time), so
-//! a rebuilt or upgraded illumlab never reads a tree another build made. An entry holds the nodes, their children's
+//! this format's version and the program's identity ([`DiskCache::hasher`]), so a rebuilt or upgraded illumlab
+//! never reads a tree another build made. An entry holds the nodes, their children's
 //! groups, the number of triangles in each packet and the order, then their XXH3 checksum; the packets are made
 //! again from the positions. Its structure is checked when it is read (every node and packet reached once from the
 //! root, every index in range, the order a permutation): a file that fails any check is ignored and written again.
 //!
-//! Where: `trees` in [`user_cache_folder`] (`$XDG_CACHE_HOME/illumlab`, else `~/.cache/illumlab`);
-//! `ILLUMLAB_CACHE=off` in the environment turns it off. Entries are written whole under a temporary name, then
-//! renamed; the folder is kept under [`CACHE_BYTES`], the entries used least recently removed first.
+//! Where: `trees` in the user's cache folder ([`DiskCache::in_user_cache`]).
 
 use super::Accel;
 use super::node::{Child, ChildGroups, Node8};
 use super::packet::TrianglePacket;
+use crate::scene::disk_cache::DiskCache;
 use glam::Vec3;
 use rayon::prelude::*;
-use std::fs;
 use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::SystemTime;
 use xxhash_rust::xxh3::Xxh3;
 
 /// Meshes with fewer triangles are built every time: their build takes a few milliseconds or less.
 pub const MIN_TRIANGLES: usize = 16_384;
-
-/// The most the folder's entries may take together.
-pub const CACHE_BYTES: u64 = 1 << 30;
 
 /// Raised whenever an entry's layout changes (a change of the build is a change of the program's identity).
 const FORMAT: u32 = 1;
@@ -42,32 +35,26 @@ const MAGIC: [u8; 16] = *b"illumlab tree\0\0\0";
 /// A folder of built trees.
 #[derive(Clone, Debug)]
 pub struct TreeCache {
-    dir: PathBuf,
+    disk: DiskCache,
 }
 
 impl TreeCache {
     pub fn new(dir: impl Into<PathBuf>) -> Self {
-        Self { dir: dir.into() }
+        Self { disk: DiskCache::new(dir, "tree") }
     }
 
-    /// The cache the environment asks for (see the module's documentation), read once per process.
+    /// `trees` in the user's cache folder, unless the environment turns caches off ([`DiskCache::in_user_cache`]);
+    /// read once per process.
     pub fn from_env() -> Option<&'static TreeCache> {
         static CACHE: OnceLock<Option<TreeCache>> = OnceLock::new();
-        CACHE
-            .get_or_init(|| {
-                let off = std::env::var("ILLUMLAB_CACHE").is_ok_and(|v| v.eq_ignore_ascii_case("off"));
-                let folder = user_cache_folder().filter(|_| !off)?;
-                Some(TreeCache::new(folder.join("trees")))
-            })
-            .as_ref()
+        CACHE.get_or_init(|| DiskCache::in_user_cache("trees", "tree").map(|disk| TreeCache { disk })).as_ref()
     }
 
     /// The key of the tree [`Accel::build`] makes of `positions` and `groups`.
     pub fn key(positions: &[[Vec3; 3]], groups: &[Option<u32>]) -> u128 {
-        let mut hash = Xxh3::new();
+        let mut hash = DiskCache::hasher();
         hash.update(&MAGIC);
         hash.update(&FORMAT.to_le_bytes());
-        hash.update(program_identity().as_bytes());
         hash.update(&(positions.len() as u64).to_le_bytes());
         hash.update(bytemuck::cast_slice(positions));
         for chunk in groups.chunks(4096) {
@@ -77,94 +64,16 @@ impl TreeCache {
         hash.digest128()
     }
 
-    fn path(&self, key: u128) -> PathBuf {
-        self.dir.join(format!("{key:032x}.tree"))
-    }
-
     /// The tree stored under `key` for the triangles `positions`, with its order, if there is a sound one.
     pub fn load(&self, key: u128, positions: &[[Vec3; 3]]) -> Option<(Accel, Vec<u32>)> {
-        let path = self.path(key);
-        let mut file = fs::File::open(&path).ok()?;
-        let bytes = file.metadata().ok()?.len();
-        let tree = read_entry(&mut file, bytes, key, positions)?;
-        // Used now: the last to be removed when the folder is full (a failure only makes it older).
-        let _ = fs::File::options().write(true).open(&path).and_then(|f| f.set_modified(SystemTime::now()));
-        Some(tree)
+        let (mut file, bytes) = self.disk.open(key)?;
+        read_entry(&mut file, bytes, key, positions)
     }
 
-    /// Stores `tree` and `order` under `key`, then trims the folder to [`CACHE_BYTES`].
+    /// Stores `tree` and `order` under `key`.
     pub fn store(&self, key: u128, tree: &Accel, order: &[u32]) -> std::io::Result<()> {
-        fs::create_dir_all(&self.dir)?;
-        // A name no other writer uses, in this process or another.
-        static WRITES: AtomicU64 = AtomicU64::new(0);
-        let write = WRITES.fetch_add(1, Ordering::Relaxed);
-        let temporary = self.dir.join(format!("{key:032x}.{}-{write}.partial", std::process::id()));
-        let written = fs::File::create(&temporary).and_then(|f| {
-            let mut out = std::io::BufWriter::new(f);
-            write_entry(&mut out, key, tree, order)?;
-            out.flush()
-        });
-        match written.and_then(|()| fs::rename(&temporary, self.path(key))) {
-            Ok(()) => self.trim(CACHE_BYTES),
-            Err(e) => {
-                let _ = fs::remove_file(&temporary);
-                Err(e)
-            }
-        }
+        self.disk.store(key, |out| write_entry(out, key, tree, order))
     }
-
-    /// Removes the least recently used entries (and leftover partial files) until the rest take at most `limit`
-    /// bytes.
-    fn trim(&self, limit: u64) -> std::io::Result<()> {
-        let mut entries = Vec::new();
-        for entry in fs::read_dir(&self.dir)? {
-            let entry = entry?;
-            let (name, meta) = (entry.file_name(), entry.metadata()?);
-            let name = name.to_string_lossy();
-            let age = meta.modified().ok().and_then(|m| SystemTime::now().duration_since(m).ok());
-            if name.ends_with(".partial") && age.is_some_and(|a| a.as_secs() > 3600) {
-                let _ = fs::remove_file(entry.path());
-            } else if name.ends_with(".tree") {
-                entries.push((meta.modified().unwrap_or(SystemTime::UNIX_EPOCH), meta.len(), entry.path()));
-            }
-        }
-        entries.sort();
-        let mut total: u64 = entries.iter().map(|e| e.1).sum();
-        for (_, len, path) in entries {
-            if total <= limit {
-                break;
-            }
-            fs::remove_file(path)?;
-            total -= len;
-        }
-        Ok(())
-    }
-}
-
-/// illumlab's folder in the user's cache: `$XDG_CACHE_HOME/illumlab`, else `~/.cache/illumlab`.
-pub fn user_cache_folder() -> Option<PathBuf> {
-    let var = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
-    let base = var("XDG_CACHE_HOME").or_else(|| var("HOME").map(|home| home.join(".cache")))?;
-    Some(base.join("illumlab"))
-}
-
-/// The running program's identity: its executable's path, size and modification time ("" when unknown, which
-/// still keys each tree by its input and format).
-fn program_identity() -> &'static str {
-    static IDENTITY: OnceLock<String> = OnceLock::new();
-    IDENTITY.get_or_init(|| {
-        let exe = std::env::current_exe().ok();
-        let meta = exe.as_ref().and_then(|e| fs::metadata(e).ok());
-        let modified =
-            meta.as_ref().and_then(|m| m.modified().ok()).and_then(|m| m.duration_since(SystemTime::UNIX_EPOCH).ok());
-        format!(
-            "{} {:?} {:?} {}",
-            env!("CARGO_PKG_VERSION"),
-            exe,
-            meta.map(|m| m.len()),
-            modified.map(|m| m.as_nanos()).unwrap_or(0)
-        )
-    })
 }
 
 /// The words before the sections: magic (4), format, key (4), triangles, nodes, packets, root (first, packets,
@@ -216,7 +125,7 @@ fn sections<'a>(
     ]
 }
 
-fn write_entry(file: &mut impl Write, key: u128, tree: &Accel, order: &[u32]) -> std::io::Result<()> {
+fn write_entry(file: &mut dyn Write, key: u128, tree: &Accel, order: &[u32]) -> std::io::Result<()> {
     let (header, lengths) = (header(key, tree, order.len()), packet_lengths(tree));
     let mut sum = Xxh3::new();
     for section in sections(&header, tree, &lengths, order) {
@@ -382,6 +291,7 @@ impl Accel {
 mod tests {
     use super::*;
     use crate::math::SampleRng;
+    use std::fs;
 
     /// `n` small triangles scattered in the unit cube, every fifth in group 7.
     fn soup(n: usize, seed: u64) -> (Vec<[Vec3; 3]>, Vec<Option<u32>>) {
@@ -459,7 +369,7 @@ mod tests {
         let key = TreeCache::key(&positions, &groups);
         let built = Accel::build(&positions, &groups);
         cache.store(key, &built.0, &built.1).unwrap();
-        let path = cache.path(key);
+        let path = cache.disk.path(key);
         let good = fs::read(&path).unwrap();
         // One bit flipped anywhere (header, nodes, packets, order, checksum), cut short, or made longer.
         for at in [0, 20, 64, 64 + 300, good.len() / 2, good.len() - 4 * 2000 - 11, good.len() - 1] {
@@ -477,7 +387,7 @@ mod tests {
         // Rebuilt and stored again over the damaged file.
         let (positions, groups) = soup(MIN_TRIANGLES, 6);
         let key = TreeCache::key(&positions, &groups);
-        fs::write(cache.path(key), b"not a tree").unwrap();
+        fs::write(cache.disk.path(key), b"not a tree").unwrap();
         let (tree, order) = Accel::build_cached(&positions, &groups, Some(&cache));
         assert!(!tree.from_cache());
         assert_same(&cache.load(key, &positions).expect("replaced"), &(tree, order));
@@ -507,24 +417,5 @@ mod tests {
         let mut short = tree.clone();
         short.packets[0].ids[1..].fill(u32::MAX);
         assert!(store(&short, &order).is_none(), "packets holding fewer triangles than the mesh");
-    }
-
-    #[test]
-    fn the_folder_keeps_the_entries_used_last() {
-        let dir = tempfile::tempdir().unwrap();
-        let cache = TreeCache::new(dir.path());
-        let now = SystemTime::now();
-        for (i, age) in [30u64, 10, 20].into_iter().enumerate() {
-            let path = dir.path().join(format!("{i}.tree"));
-            fs::write(&path, [0u8; 100]).unwrap();
-            let when = now - std::time::Duration::from_secs(age);
-            fs::File::options().write(true).open(&path).unwrap().set_modified(when).unwrap();
-        }
-        fs::write(dir.path().join("other.txt"), [0u8; 1000]).unwrap();
-        cache.trim(250).unwrap();
-        let mut left: Vec<String> =
-            fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into()).collect();
-        left.sort();
-        assert_eq!(left, ["1.tree", "2.tree", "other.txt"], "the oldest entry goes; other files stay");
     }
 }

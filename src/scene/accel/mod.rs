@@ -21,7 +21,7 @@ mod traverse;
 mod vectors;
 
 pub use blockers::ShadowBlockers;
-pub use cache::{TreeCache, user_cache_folder};
+pub use cache::TreeCache;
 pub use frustum::{ConeCandidates, ConeTriangles};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
