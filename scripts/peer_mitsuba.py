@@ -152,7 +152,7 @@ def main():
           f"Dr.Jit {dr.__version__}")
     print()
     print("| scene | strategy | illumlab whole process, s | Mitsuba warm render, s | illumlab faster by | "
-          "each round's ratio, range | tree built: illumlab s, faster by | mean radiance illumlab / Mitsuba |")
+          "each round's ratio, range | caches off: illumlab s, faster by | mean radiance illumlab / Mitsuba |")
     print("|---|---|---:|---:|---:|---:|---:|---|")
     for scene_path in scenes:
         name = os.path.basename(scene_path).removesuffix(".toml")
