@@ -8,7 +8,7 @@
 //! `ILLUMLAB_CACHE=off` in the environment turns these caches off.
 
 use std::fs;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -123,6 +123,36 @@ impl DiskCache {
         }
         Ok(())
     }
+}
+
+/// The first nine words of an entry: its format's magic (16 bytes) and version, and the entry's key.
+pub fn entry_head(magic: [u8; 16], format: u32, key: u128) -> [u32; 9] {
+    let mut words = [0; 9];
+    words[..4].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(magic));
+    words[4] = format;
+    words[5..].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(key.to_le_bytes()));
+    words
+}
+
+/// Writes an entry's `sections` one after another, then their XXH3 checksum (8 bytes).
+pub fn write_sections(out: &mut dyn Write, sections: &[&[u8]]) -> std::io::Result<()> {
+    let mut sum = Xxh3::new();
+    for section in sections {
+        sum.update(section);
+        out.write_all(section)?;
+    }
+    out.write_all(&sum.digest().to_le_bytes())
+}
+
+/// `Some` if the next eight bytes of `file` are the XXH3 checksum of `sections` (read before them).
+pub fn check_sum(file: &mut impl Read, sections: &[&[u8]]) -> Option<()> {
+    let mut stored = [0u8; 8];
+    file.read_exact(&mut stored).ok()?;
+    let mut sum = Xxh3::new();
+    for section in sections {
+        sum.update(section);
+    }
+    (sum.digest() == u64::from_le_bytes(stored)).then_some(())
 }
 
 #[cfg(test)]

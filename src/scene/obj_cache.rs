@@ -10,12 +10,11 @@
 //! a range of the text on character boundaries. Where: `objs` in the user's cache folder
 //! ([`DiskCache::in_user_cache`]).
 
-use super::disk_cache::DiskCache;
+use super::disk_cache::{DiskCache, check_sum, entry_head, write_sections};
 use super::obj::{Parsed, Statement};
 use rayon::prelude::*;
 use std::io::{Read, Write};
 use std::sync::OnceLock;
-use xxhash_rust::xxh3::Xxh3;
 
 /// Raised whenever an entry's layout changes (a change of the reader is a change of the program's identity).
 const FORMAT: u32 = 1;
@@ -23,7 +22,8 @@ const FORMAT: u32 = 1;
 /// The first bytes of an entry.
 const MAGIC: [u8; 16] = *b"illumlab obj\0\0\0\0";
 
-/// The header: magic, format and key (8 words), the counts of positions, triangles and statements (as u64).
+/// The header: magic, format and key (9 words), one of padding, the counts of positions, triangles and statements
+/// (as u64).
 const HEADER_WORDS: usize = 4 + 1 + 4 + 1 + 6;
 
 /// A folder of read OBJ texts.
@@ -70,9 +70,7 @@ impl ObjCache {
 
 fn header(key: u128, positions: usize, triangles: usize, statements: usize) -> [u32; HEADER_WORDS] {
     let mut words = [0; HEADER_WORDS];
-    words[..4].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(MAGIC));
-    words[4] = FORMAT;
-    words[5..9].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(key.to_le_bytes()));
+    words[..9].copy_from_slice(&entry_head(MAGIC, FORMAT, key));
     for (k, count) in [positions, triangles, statements].into_iter().enumerate() {
         words[10 + 2 * k] = count as u32;
         words[11 + 2 * k] = (count as u64 >> 32) as u32;
@@ -95,18 +93,18 @@ fn write_entry(out: &mut dyn Write, key: u128, parsed: &Parsed, text: &str) -> s
     let counts = (parsed.positions.len(), parsed.triangles.len(), parsed.statements.len());
     let head = header(key, counts.0, counts.1, counts.2);
     let statements: Vec<[u64; 4]> = parsed.statements.iter().map(|s| statement_words(s, text)).collect();
-    let sections: [&[u8]; 4] = [
-        bytemuck::cast_slice(&head),
+    write_sections(out, &sections(&head, &parsed, &statements))
+}
+
+/// An entry's sections in order, as bytes: the header, the positions, the triangles and the statements; the file
+/// ends with their XXH3 checksum.
+fn sections<'a>(head: &'a [u32; HEADER_WORDS], parsed: &'a Parsed, statements: &'a [[u64; 4]]) -> [&'a [u8]; 4] {
+    [
+        bytemuck::cast_slice(head),
         bytemuck::cast_slice(&parsed.positions),
         bytemuck::cast_slice(&parsed.triangles),
-        bytemuck::cast_slice(&statements),
-    ];
-    let mut sum = Xxh3::new();
-    for section in sections {
-        sum.update(section);
-        out.write_all(section)?;
-    }
-    out.write_all(&sum.digest().to_le_bytes())
+        bytemuck::cast_slice(statements),
+    ]
 }
 
 fn read_entry<'a>(file: &mut impl Read, bytes: u64, key: u128, text: &'a str) -> Option<Parsed<'a>> {
@@ -131,20 +129,7 @@ fn read_entry<'a>(file: &mut impl Read, bytes: u64, key: u128, text: &'a str) ->
     file.read_exact(bytemuck::cast_slice_mut(&mut parsed.positions)).ok()?;
     file.read_exact(bytemuck::cast_slice_mut(&mut parsed.triangles)).ok()?;
     file.read_exact(bytemuck::cast_slice_mut(&mut words)).ok()?;
-    let mut stored = [0u8; 8];
-    file.read_exact(&mut stored).ok()?;
-    let mut sum = Xxh3::new();
-    for section in [
-        bytemuck::cast_slice::<_, u8>(&head),
-        bytemuck::cast_slice(&parsed.positions),
-        bytemuck::cast_slice(&parsed.triangles),
-        bytemuck::cast_slice(&words),
-    ] {
-        sum.update(section);
-    }
-    if sum.digest() != u64::from_le_bytes(stored) {
-        return None;
-    }
+    check_sum(file, &sections(&head, &parsed, &words))?;
     if parsed.triangles.par_iter().any(|t| t.iter().any(|&i| i as usize >= positions)) {
         return None;
     }

@@ -15,13 +15,12 @@
 use super::Accel;
 use super::node::{Child, ChildGroups, Node8};
 use super::packet::TrianglePacket;
-use crate::scene::disk_cache::DiskCache;
+use crate::scene::disk_cache::{DiskCache, check_sum, entry_head, write_sections};
 use glam::Vec3;
 use rayon::prelude::*;
 use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::sync::OnceLock;
-use xxhash_rust::xxh3::Xxh3;
 
 /// Meshes with fewer triangles are built every time: their build takes a few milliseconds or less.
 pub const MIN_TRIANGLES: usize = 16_384;
@@ -82,9 +81,7 @@ const HEADER_WORDS: usize = 16;
 
 fn header(key: u128, tree: &Accel, triangles: usize) -> [u32; HEADER_WORDS] {
     let mut words = [0; HEADER_WORDS];
-    words[..4].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(MAGIC));
-    words[4] = FORMAT;
-    words[5..9].copy_from_slice(&bytemuck::cast::<_, [u32; 4]>(key.to_le_bytes()));
+    words[..9].copy_from_slice(&entry_head(MAGIC, FORMAT, key));
     let root = tree.root.unwrap_or_default();
     let (nodes, packets) = (tree.nodes.len() as u32, tree.packets.len() as u32);
     words[9..15].copy_from_slice(&[
@@ -127,12 +124,7 @@ fn sections<'a>(
 
 fn write_entry(file: &mut dyn Write, key: u128, tree: &Accel, order: &[u32]) -> std::io::Result<()> {
     let (header, lengths) = (header(key, tree, order.len()), packet_lengths(tree));
-    let mut sum = Xxh3::new();
-    for section in sections(&header, tree, &lengths, order) {
-        sum.update(section);
-        file.write_all(section)?;
-    }
-    file.write_all(&sum.digest().to_le_bytes())
+    write_sections(file, &sections(&header, tree, &lengths, order))
 }
 
 /// The tree in `file` (of `bytes` bytes), if it is an entry of this format for `key` over `positions`, whole,
@@ -142,9 +134,7 @@ fn read_entry(file: &mut impl Read, bytes: u64, key: u128, positions: &[[Vec3; 3
     let mut head = [0u32; HEADER_WORDS];
     file.read_exact(bytemuck::cast_slice_mut(&mut head)).ok()?;
     let [n, nodes, packets, first, leaf_packets, present] = head[9..15].try_into().ok()?;
-    if head[..4] != bytemuck::cast::<_, [u32; 4]>(MAGIC)
-        || head[4] != FORMAT
-        || head[5..9] != bytemuck::cast::<_, [u32; 4]>(key.to_le_bytes())
+    if head[..9] != entry_head(MAGIC, FORMAT, key)
         || head[15] != 0
         || n as usize != triangles
         || nodes as usize > triangles
@@ -176,15 +166,7 @@ fn read_entry(file: &mut impl Read, bytes: u64, key: u128, positions: &[[Vec3; 3
     read(bytemuck::cast_slice_mut(&mut tree.groups))?;
     read(&mut lengths)?;
     read(bytemuck::cast_slice_mut(&mut order))?;
-    let mut stored = [0u8; 8];
-    read(&mut stored)?;
-    let mut sum = Xxh3::new();
-    for section in sections(&head, &tree, &lengths, &order) {
-        sum.update(section);
-    }
-    if sum.digest() != u64::from_le_bytes(stored) {
-        return None;
-    }
+    check_sum(file, &sections(&head, &tree, &lengths, &order))?;
     permutation(&order, triangles)?;
     tree.packets = packets_again(&lengths[..packets], &order, positions)?;
     tree.depth = sound_depth(&tree)?;
