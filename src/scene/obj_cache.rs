@@ -93,7 +93,7 @@ fn write_entry(out: &mut dyn Write, key: u128, parsed: &Parsed, text: &str) -> s
     let counts = (parsed.positions.len(), parsed.triangles.len(), parsed.statements.len());
     let head = header(key, counts.0, counts.1, counts.2);
     let statements: Vec<[u64; 4]> = parsed.statements.iter().map(|s| statement_words(s, text)).collect();
-    write_sections(out, &sections(&head, &parsed, &statements))
+    write_sections(out, &sections(&head, parsed, &statements))
 }
 
 /// An entry's sections in order, as bytes: the header, the positions, the triangles and the statements; the file
