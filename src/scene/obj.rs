@@ -58,6 +58,14 @@ pub(super) enum Statement<'a> {
     Usemtl(&'a str),
 }
 
+/// What is known of a text of lines before they are read: whether it may hold a comment, and whether it is all
+/// ASCII (its words then found byte by byte).
+#[derive(Clone, Copy)]
+struct Text {
+    comments: bool,
+    ascii: bool,
+}
+
 /// What one chunk of lines holds.
 #[derive(Default)]
 struct Chunk<'a> {
@@ -245,7 +253,7 @@ fn line_of_triangle(piece: &str, t: usize) -> (usize, &str) {
     let mut chunk = Chunk::default();
     for (at, line) in piece.split('\n').enumerate() {
         // The piece was read without error, so it reads again without one.
-        let _ = chunk.read_line(line);
+        let _ = chunk.read_line(line, Text { comments: true, ascii: false });
         if chunk.triangles.len() > t {
             return (at, line);
         }
@@ -256,8 +264,10 @@ fn line_of_triangle(piece: &str, t: usize) -> (usize, &str) {
 impl<'a> Chunk<'a> {
     fn read(piece: &'a str) -> Self {
         let mut chunk = Chunk::default();
+        // Asked once of the piece rather than of each line (most files have neither).
+        let text = Text { comments: piece.contains('#'), ascii: piece.is_ascii() };
         for (at, line) in piece.split('\n').enumerate() {
-            if let Err(message) = chunk.read_line(line) {
+            if let Err(message) = chunk.read_line(line, text) {
                 chunk.error = Some((at, format!("'{}': {message}", line.trim())));
                 break;
             }
@@ -266,9 +276,9 @@ impl<'a> Chunk<'a> {
         chunk
     }
 
-    fn read_line(&mut self, line: &'a str) -> Result<(), String> {
-        let line = &line[..line.find('#').unwrap_or(line.len())];
-        let mut words = line.split_whitespace();
+    fn read_line(&mut self, line: &'a str, text: Text) -> Result<(), String> {
+        let line = if text.comments { &line[..line.find('#').unwrap_or(line.len())] } else { line };
+        let mut words = if text.ascii { Words::Ascii(line) } else { Words::of(line) };
         let Some(word) = words.next() else { return Ok(()) };
         // The rest of the line after the word, trimmed.
         let rest = || line.trim_start()[word.len()..].trim();
@@ -332,11 +342,11 @@ impl<'a> Chunk<'a> {
     /// at or above 2³¹ ([`MAX_POSITIONS`]).
     fn corner(&self, word: &str) -> Result<(u32, bool), String> {
         let malformed = || format!("'{word}' is not a face corner (v, v/vt, v//vn or v/vt/vn, integers)");
-        let mut parts = word.split('/');
-        let v: i64 = parts.next().and_then(|v| v.parse().ok()).ok_or_else(malformed)?;
+        let mut parts = word.as_bytes().split(|&b| b == b'/');
+        let v = parts.next().and_then(parse_index).ok_or_else(malformed)?;
         // The texture coordinate's and the normal's indices: integers or nothing, and unused.
         for (k, part) in parts.enumerate() {
-            if k >= 2 || !(part.is_empty() || part.parse::<i64>().is_ok()) {
+            if k >= 2 || !(part.is_empty() || parse_index(part).is_some()) {
                 return Err(malformed());
             }
         }
@@ -348,6 +358,63 @@ impl<'a> Chunk<'a> {
                 // Below −2³¹ it is before the file's first vertex whatever the chunk's place.
                 let from_chunk = from_chunk.max(i32::MIN as i64);
                 Ok((from_chunk as u32, true))
+            }
+        }
+    }
+}
+
+/// An index as `str::parse::<i64>` reads it (an optional sign, then decimal digits, within i64), from bytes.
+fn parse_index(bytes: &[u8]) -> Option<i64> {
+    let (negative, digits) = match bytes.split_first() {
+        Some((b'-', rest)) => (true, rest),
+        Some((b'+', rest)) => (false, rest),
+        _ => (false, bytes),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    // Summed below zero, where i64 reaches one further (−2⁶³).
+    let mut value: i64 = 0;
+    for &b in digits {
+        let digit = b.wrapping_sub(b'0');
+        if digit > 9 {
+            return None;
+        }
+        value = value.checked_mul(10)?.checked_sub(i64::from(digit))?;
+    }
+    if negative { Some(value) } else { value.checked_neg() }
+}
+
+/// The words of a line, as `str::split_whitespace` gives them; where the line is ASCII, found byte by byte
+/// (Unicode's white space among ASCII characters: tab, line feed, vertical tab, form feed, carriage return, space).
+enum Words<'a> {
+    Ascii(&'a str),
+    Unicode(std::str::SplitWhitespace<'a>),
+}
+
+impl<'a> Words<'a> {
+    fn of(line: &'a str) -> Self {
+        if line.is_ascii() { Words::Ascii(line) } else { Words::Unicode(line.split_whitespace()) }
+    }
+}
+
+impl<'a> Iterator for Words<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        match self {
+            Words::Unicode(words) => words.next(),
+            Words::Ascii(rest) => {
+                let space = |b: &u8| *b == b' ' || (b'\t'..=b'\r').contains(b);
+                let bytes = rest.as_bytes();
+                let Some(start) = bytes.iter().position(|b| !space(b)) else {
+                    *rest = "";
+                    return None;
+                };
+                let end = bytes[start..].iter().position(space).map_or(bytes.len(), |len| start + len);
+                let word = &rest[start..end];
+                *rest = &rest[end..];
+                Some(word)
             }
         }
     }
@@ -505,6 +572,39 @@ mod tests {
         for size in 1..text.len() {
             let g = read_chunked(text, size, |_| Ok(Vec::new())).unwrap();
             assert_eq!(g.triangles, [[0, 1, 2], [0, 1, 2]], "pieces of {size}");
+        }
+    }
+
+    #[test]
+    fn indices_and_words_are_read_as_the_standard_library_reads_them() {
+        let indices = [
+            "0",
+            "7",
+            "-7",
+            "+7",
+            "007",
+            "-0",
+            "+",
+            "-",
+            "",
+            "1a",
+            " 1",
+            "1 ",
+            "--1",
+            "+-1",
+            "9223372036854775807",
+            "9223372036854775808",
+            "-9223372036854775808",
+            "-9223372036854775809",
+            "99999999999999999999",
+            "١",
+        ];
+        for text in indices {
+            assert_eq!(parse_index(text.as_bytes()), text.parse::<i64>().ok(), "{text:?}");
+        }
+        let lines = ["", " ", "v 1 2 3", "\tf  1/2/3\x0b4//5\x0c6\r", "  g a b  ", "usemtl\u{a0}red x", "f 1\u{3000}2"];
+        for line in lines {
+            assert_eq!(Words::of(line).collect::<Vec<_>>(), line.split_whitespace().collect::<Vec<_>>(), "{line:?}");
         }
     }
 
