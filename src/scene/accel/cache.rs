@@ -353,7 +353,7 @@ mod tests {
         cache.store(key, &built.0, &built.1).unwrap();
         let path = cache.disk.path(key);
         let good = fs::read(&path).unwrap();
-        // One bit flipped anywhere (header, nodes, packets, order, checksum), cut short, or made longer.
+        // One bit flipped anywhere (header, nodes, packet lengths, order, checksum), cut short, or made longer.
         for at in [0, 20, 64, 64 + 300, good.len() / 2, good.len() - 4 * 2000 - 11, good.len() - 1] {
             let mut bad = good.clone();
             bad[at] ^= 0x10;
