@@ -2,8 +2,9 @@
 # Loading a big mesh: writes a rippled grid of 1 002 528 triangles (a 37.7 MB OBJ) and times the whole
 # `illumlab render` process on it at 4×4 pixels and 1 spp (so nearly all of it is parsing the OBJ and building the
 # BVH), ROUNDS times; prints each run's wall seconds and peak RSS, and the peak RSS per triangle. Each round runs
-# three loads, in a tree cache of its own (scene::TreeCache, under the script's temporary folder): `built` with the
-# cache off, `stored` (built, then written to the empty cache) and `read` (the tree read back from it).
+# three loads, in a cache folder of its own (the tree and OBJ caches, scene::DiskCache, under the script's temporary
+# folder): `built` with the caches off, `stored` (read and built, then written to the empty caches) and `read` (the
+# OBJ's geometry and the tree read back from them).
 # Usage: scripts/load-million.sh [ROUNDS] [BINARY ...]   (default 5, target/release/illumlab; several binaries
 # run in turn, round by round)
 set -euo pipefail

@@ -9,10 +9,10 @@ emitter_samples=1, bsdf_samples=1 (both power-heuristic MIS of one light and one
 
 Timed: illumlab's whole `render` process (load, BVH, render, EXR written) against Mitsuba's warm render (the
 second `mi.render` of the scene in one process, its kernels compiled and cached; scene loading not counted), each
-ROUNDS times, in turn. Both are warm: Mitsuba's kernels compiled (Dr.Jit keeps them on disk), illumlab's tree in
-its cache (scene::TreeCache; a mesh of 16 384 triangles or more, here the knot), each filled by an untimed first
-run. illumlab's process with the tree built (its cache off) is timed too, in the same rounds. The mean radiance of
-both images is printed: the same integral, so they must agree.
+ROUNDS times, in turn. Both are warm: Mitsuba's kernels compiled (Dr.Jit keeps them on disk), illumlab's tree and
+OBJ geometry in its caches (scene::DiskCache: a mesh of 16 384 triangles or more, an OBJ of 1 MiB or more; here the
+knot), each filled by an untimed first run. illumlab's process with its caches off is timed too, in the same
+rounds. The mean radiance of both images is printed: the same integral, so they must agree.
 """
 
 import os
@@ -135,7 +135,7 @@ def render_mitsuba(scene, spp, seed):
 
 def render_illumlab(binary, toml, strategy, size, spp, seed, out, cache):
     """Seconds of the whole `illumlab render` process and the image's mean radiance; `cache` is the folder of
-    illumlab's caches, or None to build the tree."""
+    illumlab's caches, or None to turn them off."""
     cmd = [binary, "render", toml, "--strategy", strategy, "--spp", str(spp), "--size", f"{size}x{size}",
            "--seed", str(seed), "-o", out]
     env = dict(os.environ, XDG_CACHE_HOME=cache or "", ILLUMLAB_CACHE="on" if cache else "off")
