@@ -15,6 +15,7 @@ mod material;
 mod mtl;
 mod obj;
 mod obj_cache;
+mod obj_words;
 mod tile_lights;
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 
 use super::SceneError;
 use super::obj_cache::ObjCache;
+use super::obj_words::{Words, parse_index};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::collections::HashMap;
@@ -363,63 +364,6 @@ impl<'a> Chunk<'a> {
     }
 }
 
-/// An index as `str::parse::<i64>` reads it (an optional sign, then decimal digits, within i64), from bytes.
-fn parse_index(bytes: &[u8]) -> Option<i64> {
-    let (negative, digits) = match bytes.split_first() {
-        Some((b'-', rest)) => (true, rest),
-        Some((b'+', rest)) => (false, rest),
-        _ => (false, bytes),
-    };
-    if digits.is_empty() {
-        return None;
-    }
-    // Summed below zero, where i64 reaches one further (−2⁶³).
-    let mut value: i64 = 0;
-    for &b in digits {
-        let digit = b.wrapping_sub(b'0');
-        if digit > 9 {
-            return None;
-        }
-        value = value.checked_mul(10)?.checked_sub(i64::from(digit))?;
-    }
-    if negative { Some(value) } else { value.checked_neg() }
-}
-
-/// The words of a line, as `str::split_whitespace` gives them; where the line is ASCII, found byte by byte
-/// (Unicode's white space among ASCII characters: tab, line feed, vertical tab, form feed, carriage return, space).
-enum Words<'a> {
-    Ascii(&'a str),
-    Unicode(std::str::SplitWhitespace<'a>),
-}
-
-impl<'a> Words<'a> {
-    fn of(line: &'a str) -> Self {
-        if line.is_ascii() { Words::Ascii(line) } else { Words::Unicode(line.split_whitespace()) }
-    }
-}
-
-impl<'a> Iterator for Words<'a> {
-    type Item = &'a str;
-
-    fn next(&mut self) -> Option<&'a str> {
-        match self {
-            Words::Unicode(words) => words.next(),
-            Words::Ascii(rest) => {
-                let space = |b: &u8| *b == b' ' || (b'\t'..=b'\r').contains(b);
-                let bytes = rest.as_bytes();
-                let Some(start) = bytes.iter().position(|b| !space(b)) else {
-                    *rest = "";
-                    return None;
-                };
-                let end = bytes[start..].iter().position(space).map_or(bytes.len(), |len| start + len);
-                let word = &rest[start..end];
-                *rest = &rest[end..];
-                Some(word)
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -572,39 +516,6 @@ mod tests {
         for size in 1..text.len() {
             let g = read_chunked(text, size, |_| Ok(Vec::new())).unwrap();
             assert_eq!(g.triangles, [[0, 1, 2], [0, 1, 2]], "pieces of {size}");
-        }
-    }
-
-    #[test]
-    fn indices_and_words_are_read_as_the_standard_library_reads_them() {
-        let indices = [
-            "0",
-            "7",
-            "-7",
-            "+7",
-            "007",
-            "-0",
-            "+",
-            "-",
-            "",
-            "1a",
-            " 1",
-            "1 ",
-            "--1",
-            "+-1",
-            "9223372036854775807",
-            "9223372036854775808",
-            "-9223372036854775808",
-            "-9223372036854775809",
-            "99999999999999999999",
-            "١",
-        ];
-        for text in indices {
-            assert_eq!(parse_index(text.as_bytes()), text.parse::<i64>().ok(), "{text:?}");
-        }
-        let lines = ["", " ", "v 1 2 3", "\tf  1/2/3\x0b4//5\x0c6\r", "  g a b  ", "usemtl\u{a0}red x", "f 1\u{3000}2"];
-        for line in lines {
-            assert_eq!(Words::of(line).collect::<Vec<_>>(), line.split_whitespace().collect::<Vec<_>>(), "{line:?}");
         }
     }
 
