@@ -3,7 +3,7 @@
 //! the samples, so a pass of 32 samples per pixel does not walk the tree once per pixel to find them again. Kept
 //! as triangle ids (4 bytes a triangle), a row at a time, each row filled by the thread that renders it first.
 
-use crate::scene::{Camera, CameraBasis, ConeCandidates, Scene, TileLights};
+use crate::scene::{Camera, CameraBasis, MAX_CONE, Scene, TileLights};
 use std::sync::OnceLock;
 
 /// The cones of every pixel of one camera's image, row by row, and what its tiles' shadow rays can meet
@@ -25,8 +25,9 @@ static NO_LIGHTS: TileLights = TileLights::NONE;
 /// much as the shadow rays it saved the Cornell box at 256 samples).
 const TILE: u32 = 4;
 
-/// One row's cones: pixel x's triangles are `ids[ends[x − 1]..ends[x]]` (from 0 for x = 0), or [`NO_CONE`]
-/// alone for a pixel whose rays can hit more than eight triangles.
+/// One row's cones: pixel x's triangles are `ids[ends[x − 1]..ends[x]]` (from 0 for x = 0) in
+/// `Accel::cone_triangles`' order, or [`NO_CONE`] alone for a pixel whose rays can hit more than [`MAX_CONE`]
+/// triangles.
 struct RowCones {
     ends: Vec<u32>,
     ids: Vec<u32>,
@@ -52,20 +53,21 @@ impl PixelCones {
         &self.camera
     }
 
-    /// The cone of every pixel of row `y` (of `width` pixels), one at a time, with its tile's lights:
-    /// `None` (and [`TileLights::NONE`]) for a pixel whose rays can hit more than eight triangles. Found on the
-    /// first call for the row (the lights, for the tile).
+    /// The cone of every pixel of row `y` (of `width` pixels), one at a time, as its triangles' ids (for
+    /// `Scene::cone`), with its tile's lights: `None` for a pixel whose rays can hit more than [`MAX_CONE`] triangles, and [`TileLights::NONE`] where
+    /// they can hit more than eight (the tile's cone, which holds the pixel's, then has more than eight too).
+    /// Found on the first call for the row (the lights, for the tile).
     pub(super) fn row<'a>(
         &'a self,
         scene: &'a Scene,
         camera: &'a CameraBasis,
         y: u32,
         width: u32,
-    ) -> impl Iterator<Item = (Option<ConeCandidates>, &'a TileLights)> + 'a {
+    ) -> impl Iterator<Item = (Option<&'a [u32]>, &'a TileLights)> + 'a {
         let row = self.rows[y as usize].get_or_init(|| {
             let mut row = RowCones { ends: Vec::with_capacity(width as usize), ids: Vec::new() };
             for x in 0..width {
-                match scene.accel().cone_triangles(camera.eye(), camera.pixel_corners(x, y)) {
+                match scene.accel().cone_triangles(camera.eye(), camera.pixel_corners(x, y), MAX_CONE) {
                     Some(ids) => row.ids.extend_from_slice(&ids),
                     None => row.ids.push(NO_CONE),
                 }
@@ -75,15 +77,15 @@ impl PixelCones {
         });
         let starts = std::iter::once(0).chain(row.ends.iter().copied());
         let cones = starts.zip(&row.ends).map(move |(start, &end)| match &row.ids[start as usize..end as usize] {
-            [NO_CONE] => None,
-            ids => Some(scene.cone(camera.eye(), ids)),
+            [NO_CONE] => (None, false),
+            ids => (Some(ids), ids.len() <= 8),
         });
         let tiles = &self.tiles[(y / TILE * width.div_ceil(TILE)) as usize..];
         let same_lights = *self.lights.get_or_init(|| scene.emitters.clone()) == scene.emitters;
-        cones.zip(0..width).map(move |(cone, x)| {
+        cones.zip(0..width).map(move |((cone, few), x)| {
             let tile =
                 || tiles[(x / TILE) as usize].get_or_init(|| self.tile_lights(scene, camera, x / TILE, y / TILE));
-            let lights = if cone.is_some() && same_lights { tile() } else { &NO_LIGHTS };
+            let lights = if few && same_lights { tile() } else { &NO_LIGHTS };
             (cone, lights)
         })
     }
@@ -101,7 +103,7 @@ impl PixelCones {
         ];
         scene
             .accel()
-            .cone_triangles(camera.eye(), corners)
+            .cone_triangles(camera.eye(), corners, 8)
             .map_or(TileLights::NONE, |ids| scene.tile_lights(camera.eye(), corners, &ids))
     }
 }

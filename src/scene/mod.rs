@@ -21,8 +21,8 @@ mod tile_lights;
 #[cfg(test)]
 pub(crate) use accel::test_ray_triangle;
 pub use accel::{
-    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, SKIP_NONE, ShadowBlockers, Shaft, TreeCache, VectorPath,
-    has_avx512, vector_path,
+    Accel, ConeCandidates, ConeTriangles, Hit, HitLanes, MAX_CONE, SKIP_NONE, ShadowBlockers, Shaft, TreeCache,
+    VectorPath, has_avx512, vector_path,
 };
 #[cfg(test)]
 pub(crate) use bundled::every_bundled_scene;
@@ -193,13 +193,13 @@ impl Scene {
         v0 + (v1 - v0) * hit.u + (v2 - v0) * hit.v
     }
 
-    /// The triangles that camera rays from `apex` through the quad of directions `corners` can hit, in one
-    /// packet; `None` when there are more than eight (see [`Accel::cone_triangles`]).
+    /// The triangles that camera rays from `apex` through the quad of directions `corners` can hit, in packets;
+    /// `None` when there are more than [`MAX_CONE`] (see [`Accel::cone_triangles`]).
     pub fn cone_candidates(&self, apex: Vec3, corners: [Vec3; 4]) -> Option<ConeCandidates> {
-        Some(self.cone(apex, &self.accel.cone_triangles(apex, corners)?))
+        Some(self.cone(apex, &self.accel.cone_triangles(apex, corners, MAX_CONE)?))
     }
 
-    /// The cone from `apex` of the triangles `ids` (at most eight).
+    /// The cone from `apex` of the triangles `ids` (at most [`MAX_CONE`], as `Accel::cone_triangles` orders them).
     #[inline]
     pub fn cone(&self, apex: Vec3, ids: &[u32]) -> ConeCandidates {
         ConeCandidates::new(apex, ids.len(), |i| (self.triangles[ids[i] as usize].v, ids[i]))

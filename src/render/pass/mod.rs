@@ -282,7 +282,9 @@ impl Renderer {
                     let mut cones = (self.settings.footprint == Footprint::Jittered)
                         .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
                     for (x, acc) in row.iter_mut().enumerate() {
-                        let (cone, tile) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, &TileLights::NONE));
+                        let (ids, tile) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, &TileLights::NONE));
+                        // Made here, where it is used: moved through the rows' iterators it was copied each time.
+                        let cone = ids.map(|ids| self.scene.cone(self.camera.eye(), ids));
                         let streams = streams(x);
                         for group in (first..first + count).step_by(LANES) {
                             let samples = group..(group + LANES as u32).min(first + count);

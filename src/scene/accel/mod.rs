@@ -22,7 +22,7 @@ mod vectors;
 
 pub use blockers::ShadowBlockers;
 pub use cache::TreeCache;
-pub use frustum::{ConeCandidates, ConeTriangles};
+pub use frustum::{ConeCandidates, ConeTriangles, MAX_CONE};
 use glam::Vec3;
 use node::{Child, ChildGroups, Node8};
 use packet::TrianglePacket;

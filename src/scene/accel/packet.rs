@@ -126,17 +126,6 @@ impl TrianglePacket {
         moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), o, d, t_max)
     }
 
-    /// The nearest hit at `0 < t < t_max` of each of eight rays from `origin` along `dirs` (one per lane; those in
-    /// `active`, all bits set), with the packet's triangle ids: lane i gets the hit [`TrianglePacket::closest`] finds
-    /// for ray i, bit for bit, as the same (triangle, ray) pairs go through the same arithmetic; only the roles of the
-    /// lanes are swapped.
-    #[inline(always)]
-    pub fn closest_of_rays(&self, origin: Vec3, dirs: &Vec3x8, active: f32x8, t_max: f32) -> HitLanes {
-        let mut nearest = NearestLanes::new(t_max);
-        self.nearer_of_rays(&origin.to_array().map(f32x8::splat), &[dirs.x, dirs.y, dirs.z], active, &mut nearest);
-        nearest.hits()
-    }
-
     /// Each of eight rays `o + t·d` (one per lane; those in `active`, all bits set) keeps in `nearest` the nearer
     /// of its hit there and the packet's nearest hit at `0 < t <` that distance, as [`TrianglePacket::closest`]
     /// finds it for the ray with that limit (the triangles are tested against the limit the ray came in with,
