@@ -54,9 +54,9 @@ impl PixelCones {
     }
 
     /// The cone of every pixel of row `y` (of `width` pixels), one at a time, as its triangles' ids (for
-    /// `Scene::cone`), with its tile's lights: `None` for a pixel whose rays can hit more than [`MAX_CONE`] triangles, and [`TileLights::NONE`] where
-    /// they can hit more than eight (the tile's cone, which holds the pixel's, then has more than eight too).
-    /// Found on the first call for the row (the lights, for the tile).
+    /// `Scene::cone`), with its tile's lights: `None` for a pixel whose rays can hit more than [`MAX_CONE`]
+    /// triangles, and [`TileLights::NONE`] where they can hit more than eight (the tile's cone, which holds the
+    /// pixel's, then has more than eight too). Found on the first call for the row (the lights, for the tile).
     pub(super) fn row<'a>(
         &'a self,
         scene: &'a Scene,

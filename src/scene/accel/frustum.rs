@@ -102,7 +102,7 @@ impl ConeCandidates {
             let near = (0..len).map(|i| distance_below(apex, &triangle(8 * j + i).0)).fold(f32::INFINITY, f32::min);
             (TrianglePacket::from_fn(len, |i| triangle(8 * j + i)), near)
         };
-        // The first packet's distance is never read: it is always tested.
+        // The first packet is always tested (no ray has a hit before it): its bound is never needed.
         let first = if n == 0 { (TrianglePacket::from_fn(0, &triangle), 0.0) } else { packet(0) };
         Self { apex, first, rest: (1..n.div_ceil(8)).map(packet).collect() }
     }
@@ -230,9 +230,10 @@ mod tests {
         }
     }
 
-    /// Through a stack of thin plates (9 to 128 triangles in a pixel's cone, in several packets): more than eight
-    /// of the cone's triangles come nearest first, and more than `most` give none; every ray, alone or eight at once, finds
-    /// through the cone the distance the full traversal finds, also where the nearest packets are skipped.
+    /// Through a stack of thin plates (9 to 128 triangles in a pixel's cone, in several packets): more than
+    /// eight of the cone's triangles come nearest first, and more than `most` give none; every ray, alone or
+    /// eight at once, finds through the cone the distance the full traversal finds, also where the far packets
+    /// are skipped.
     #[test]
     fn cones_of_several_packets_find_the_closest_hit() {
         // Plates of two triangles each, 0.5 apart along −z, shifted so that pixels see several edges.
