@@ -120,8 +120,8 @@ impl ConeCandidates {
         let ray = WideRay::new(self.apex, dir);
         let (length, mut best, mut limit) = (dir.length(), None, t_max);
         for (packet, near) in self.packets() {
-            if best.is_some() && limit * length <= *near {
-                break; // nothing in this packet or after it is nearer
+            if limit * length <= *near {
+                break; // nothing in this packet or after it is nearer than the hit or the limit
             }
             if let Some(h) = packet.closest(&ray, limit) {
                 (best, limit) = (Some(Hit { triangle: packet.ids[h.lane], t: h.t, u: h.u, v: h.v }), h.t);
