@@ -1,6 +1,7 @@
 //! Pure math: orthonormal frames, robust ray origins, seeded per-sample randomness, spherical geometry,
-//! eight-lane vectors and the samplers' sin and cos.
+//! eight-lane vectors, the samplers' sin and cos, and denormals flushed while rendering.
 
+mod denormals;
 mod equal_area;
 mod frame;
 mod offset;
@@ -10,6 +11,7 @@ mod rng;
 mod trig;
 mod vec3x8;
 
+pub use denormals::without_denormals;
 pub use equal_area::{SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk};
 pub use frame::Frame;
 pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};

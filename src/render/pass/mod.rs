@@ -10,7 +10,7 @@ use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::guiding::{Guide, GuideRecord, GuideSettings, LeafHint, Training};
-use crate::math::{PixelStreams, SampleRng};
+use crate::math::{PixelStreams, SampleRng, without_denormals};
 use crate::scene::{
     Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene, TileLights,
 };
@@ -247,66 +247,8 @@ impl Renderer {
         film.pixels
             .par_chunks_mut(width as usize)
             .enumerate()
-            .map(|(y, row)| {
-                let mut stats = PassStats::default();
-                let mut records = Vec::new();
-                if (hooks.cancelled)() {
-                    return (stats, records);
-                }
-                let cpu = ThreadTime::now();
-                let mut learned = learn.then_some(&mut records);
-                let mut add = |acc: &mut PixelAccum, v: Vec3| {
-                    if !v.is_finite() {
-                        stats.non_finite += 1;
-                    } else if keep {
-                        acc.add(v);
-                    }
-                };
-                let mut rays = 0;
-                let streams = |x: usize| PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
-                if count < GROUP_MIN_SAMPLES {
-                    let mut leaf = None;
-                    for (x, acc) in row.iter_mut().enumerate() {
-                        let streams = streams(x);
-                        for s in first..first + count {
-                            let mut rng = streams.sample(s as u64);
-                            let (dir, hit) = self.camera_ray(x as u32, y as u32, &mut rng);
-                            rays += 1;
-                            let learned = learned.as_deref_mut();
-                            let shade = |hit| self.shade(dir, &hit, &mut rng, &mut rays, learned, &mut leaf);
-                            add(acc, hit.map_or(Vec3::ZERO, shade));
-                        }
-                    }
-                } else {
-                    // Through the pixel centres every sample shares one ray: no cone is needed (see below).
-                    let mut cones = (self.settings.footprint == Footprint::Jittered)
-                        .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
-                    for (x, acc) in row.iter_mut().enumerate() {
-                        let (ids, tile) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, &TileLights::NONE));
-                        // Made here, where it is used: moved through the rows' iterators it was copied each time.
-                        let cone = ids.map(|ids| self.scene.cone(self.camera.eye(), ids));
-                        let streams = streams(x);
-                        for group in (first..first + count).step_by(LANES) {
-                            let samples = group..(group + LANES as u32).min(first + count);
-                            let n = samples.len();
-                            let pixel = (x as u32, y as u32);
-                            let learned = learned.as_deref_mut();
-                            let cone = (cone.as_ref(), tile);
-                            let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
-                            if keep {
-                                stats.non_finite += acc.add_finite(&values[..n]);
-                            } else {
-                                stats.non_finite += values[..n].iter().filter(|v| !v.is_finite()).count() as u64;
-                            }
-                        }
-                    }
-                }
-                stats.rays = rays;
-                stats.samples = count as u64 * width as u64;
-                stats.cpu = cpu.elapsed();
-                (hooks.row_done)(count);
-                (stats, records)
-            })
+            // Denormals flushed (see `without_denormals`): every sample of a film is taken under the same flags.
+            .map(|(y, row)| without_denormals(|| self.render_row(row, y, (first, count), (learn, keep), hooks)))
             .collect::<Vec<_>>()
             .into_iter()
             .fold((PassStats::default(), Vec::new()), |(mut stats, mut rows), (s, records)| {
@@ -318,6 +260,78 @@ impl Renderer {
             })
     }
 
+    /// Row `y`'s samples `first..first + count` (`samples`), added to its pixels if `keep`; with `learn`, the
+    /// guide records of the row.
+    #[inline]
+    fn render_row(
+        &self,
+        row: &mut [PixelAccum],
+        y: usize,
+        (first, count): (u32, u32),
+        (learn, keep): (bool, bool),
+        hooks: &PassHooks,
+    ) -> (PassStats, Vec<GuideRecord>) {
+        let width = row.len() as u32;
+        let mut stats = PassStats::default();
+        let mut records = Vec::new();
+        if (hooks.cancelled)() {
+            return (stats, records);
+        }
+        let cpu = ThreadTime::now();
+        let mut learned = learn.then_some(&mut records);
+        let mut add = |acc: &mut PixelAccum, v: Vec3| {
+            if !v.is_finite() {
+                stats.non_finite += 1;
+            } else if keep {
+                acc.add(v);
+            }
+        };
+        let mut rays = 0;
+        let streams = |x: usize| PixelStreams::new(self.settings.seed, y as u64 * width as u64 + x as u64);
+        if count < GROUP_MIN_SAMPLES {
+            let mut leaf = None;
+            for (x, acc) in row.iter_mut().enumerate() {
+                let streams = streams(x);
+                for s in first..first + count {
+                    let mut rng = streams.sample(s as u64);
+                    let (dir, hit) = self.camera_ray(x as u32, y as u32, &mut rng);
+                    rays += 1;
+                    let learned = learned.as_deref_mut();
+                    let shade = |hit| self.shade(dir, &hit, &mut rng, &mut rays, learned, &mut leaf);
+                    add(acc, hit.map_or(Vec3::ZERO, shade));
+                }
+            }
+        } else {
+            // Through the pixel centres every sample shares one ray: no cone is needed (see below).
+            let mut cones = (self.settings.footprint == Footprint::Jittered)
+                .then(|| self.cones.row(&self.scene, &self.camera, y as u32, width));
+            for (x, acc) in row.iter_mut().enumerate() {
+                let (ids, tile) = cones.as_mut().and_then(|c| c.next()).unwrap_or((None, &TileLights::NONE));
+                // Made here, where it is used: moved through the rows' iterators it was copied each time.
+                let cone = ids.map(|ids| self.scene.cone(self.camera.eye(), ids));
+                let streams = streams(x);
+                for group in (first..first + count).step_by(LANES) {
+                    let samples = group..(group + LANES as u32).min(first + count);
+                    let n = samples.len();
+                    let pixel = (x as u32, y as u32);
+                    let learned = learned.as_deref_mut();
+                    let cone = (cone.as_ref(), tile);
+                    let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
+                    if keep {
+                        stats.non_finite += acc.add_finite(&values[..n]);
+                    } else {
+                        stats.non_finite += values[..n].iter().filter(|v| !v.is_finite()).count() as u64;
+                    }
+                }
+            }
+        }
+        stats.rays = rays;
+        stats.samples = count as u64 * width as u64;
+        stats.cpu = cpu.elapsed();
+        (hooks.row_done)(count);
+        (stats, records)
+    }
+
     /// Counts, over every `stride`-th pixel's samples `first..first + count` (taken as a pass would take them,
     /// but not added to any film), the directions along which L_i was looked for and those that found light:
     /// how often a strategy's shadow and BRDF rays pay off. Outside the timed passes: it costs what it counts.
@@ -326,19 +340,22 @@ impl Renderer {
         (0..(width as usize * height as usize))
             .into_par_iter()
             .step_by(stride.max(1))
+            // Under the passes' flags, so that a direction counts as lit where a pass finds it lit.
             .map(|i| {
-                let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
-                let streams = PixelStreams::new(self.settings.seed, i as u64);
-                let mut census = Census::default();
-                for s in first..first + count {
-                    let mut rng = streams.sample(s as u64);
-                    let (dir, hit) = self.camera_ray(x, y, &mut rng);
-                    if let Some(hit) = hit {
-                        let sp = self.shading_point(dir, &hit);
-                        self.settings.strategy.estimate(&self.context(), &sp, &mut rng, &mut 0, &mut census);
+                without_denormals(|| {
+                    let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
+                    let streams = PixelStreams::new(self.settings.seed, i as u64);
+                    let mut census = Census::default();
+                    for s in first..first + count {
+                        let mut rng = streams.sample(s as u64);
+                        let (dir, hit) = self.camera_ray(x, y, &mut rng);
+                        if let Some(hit) = hit {
+                            let sp = self.shading_point(dir, &hit);
+                            self.settings.strategy.estimate(&self.context(), &sp, &mut rng, &mut 0, &mut census);
+                        }
                     }
-                }
-                census
+                    census
+                })
             })
             .reduce(Census::default, |a, b| Census { traced: a.traced + b.traced, lit: a.lit + b.lit })
     }
