@@ -11,7 +11,7 @@
 //!
 //! Every part of a render that must give the same bits as another runs under the same flags: both the one-sample
 //! and the eight-lane path run inside [`without_denormals`] (see `render::pass`), so films stay identical with
-//! any number of threads, passes or lanes.
+//! any number of threads, passes or lanes; the census and the probe take their samples under the same flags.
 //!
 //! x86-64 only (the MXCSR's FTZ and DAZ bits); elsewhere the closure runs as it is.
 #![allow(unsafe_code)]

@@ -2,7 +2,7 @@
 //! evaluate recorded (the sink), with the estimate, its standard error, the relative variance of one sample and
 //! the histogram of sample values.
 
-use crate::math::{SampleRng, luminance};
+use crate::math::{SampleRng, luminance, without_denormals};
 use crate::render::{Outcome, SampleContext, SampleRecord, SampleSink, ShadingPoint, Strategy};
 use glam::{DVec3, Vec3};
 use std::time::{Duration, Instant};
@@ -105,10 +105,13 @@ impl ProbeRun {
         let mut rays = 0;
         {
             let mut recorder = Recorder { run: &mut run, keep, next: 0 };
-            for k in 0..samples {
-                let mut rng = SampleRng::new(seed, PROBE_STREAM, k);
-                values.push(strategy.estimate(ctx, sp, &mut rng, &mut rays, &mut recorder));
-            }
+            // Under the flags a render's samples are taken with (and timed alike).
+            without_denormals(|| {
+                for k in 0..samples {
+                    let mut rng = SampleRng::new(seed, PROBE_STREAM, k);
+                    values.push(strategy.estimate(ctx, sp, &mut rng, &mut rays, &mut recorder));
+                }
+            });
             // Oldest first.
             let next = recorder.next;
             run.records.rotate_left(next);
