@@ -7,7 +7,8 @@
 //! (`super::vector_path` says which).
 //!
 //! Calling code compiled for instructions the build does not assume takes `unsafe`: this module's `unsafe` blocks
-//! do, each only where the CPU was found to have them. Nothing else in the crate is unsafe.
+//! do, each only where the CPU was found to have them. The crate's only other `unsafe` sets and restores the
+//! floating-point control register (`math::without_denormals`).
 #![allow(unsafe_code)]
 
 use super::node::{Node8, ROBUST_EXIT};
