@@ -7,19 +7,16 @@ use super::lanes::{
     estimate_one_sample_lanes, estimate_projected_solid_angle_lanes, estimate_solid_angle_lanes,
 };
 use super::sink::{Census, Learner, SampleRecord, SampleSink};
-use super::strategy::{Brdf, Emitter, MisSettings, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
+use super::strategy::{Brdf, Emitter, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
-use crate::guiding::{Guide, GuideRecord, GuideSettings, LeafHint, Training};
+use crate::guiding::{Guide, GuideRecord, LeafHint, Training};
 use crate::math::{PixelStreams, SampleRng, without_denormals};
-use crate::scene::{
-    Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, LightSelection, Scene, TileLights,
-};
+use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, Scene, TileLights};
 use cpu_time::ThreadTime;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::sync::Arc;
-use std::time::Duration;
 use wide::{CmpLt, f32x8};
 
 /// Passes of at least this many samples per pixel gather, once per pixel, the few triangles its camera rays
@@ -33,55 +30,6 @@ const GROUP_MIN_SAMPLES: u32 = 4;
 struct PassHooks<'a> {
     cancelled: &'a (dyn Fn() -> bool + Sync),
     row_done: &'a (dyn Fn(u32) + Sync),
-}
-
-/// What a render is a function of, besides the scene.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct RenderSettings {
-    pub strategy: Strategy,
-    pub light_selection: LightSelection,
-    pub seed: u64,
-    /// Used by [`Strategy::Mis`].
-    pub mis: MisSettings,
-    /// Where camera rays go in their pixels.
-    pub footprint: Footprint,
-    /// How `guided` learns its guide.
-    pub guiding: GuideSettings,
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            strategy: Strategy::Emitter,
-            light_selection: LightSelection::Power,
-            seed: 0,
-            mis: MisSettings::default(),
-            footprint: Footprint::Jittered,
-            guiding: GuideSettings::default(),
-        }
-    }
-}
-
-/// Counts from one or more passes.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct PassStats {
-    /// Pixel samples taken (accepted + dropped).
-    pub samples: u64,
-    /// Rays traced: camera, BRDF and shadow rays.
-    pub rays: u64,
-    /// Non-finite samples dropped.
-    pub non_finite: u64,
-    /// CPU time spent on the samples, summed over threads (each row's thread CPU clock).
-    pub cpu: Duration,
-}
-
-impl std::ops::AddAssign for PassStats {
-    fn add_assign(&mut self, o: Self) {
-        self.samples += o.samples;
-        self.rays += o.rays;
-        self.non_finite += o.non_finite;
-        self.cpu += o.cpu;
-    }
 }
 
 /// Renders a scene with fixed settings, pass after pass. It owns what is built once per scene and settings and
@@ -528,5 +476,8 @@ fn mis_lanes(
     estimate_mis_lanes(ctx, techniques, dirs, hits, rngs, rays)
 }
 
+mod settings;
 #[cfg(test)]
 mod tests;
+
+pub use settings::{PassStats, RenderSettings};

@@ -1,8 +1,9 @@
 //! The pass's unit tests: kept cones, and films that do not depend on how samples are split into passes.
 
 use super::*;
-use crate::render::Heuristic;
-use crate::scene::every_bundled_scene;
+use crate::guiding::GuideSettings;
+use crate::render::{Heuristic, MisSettings};
+use crate::scene::{LightSelection, every_bundled_scene};
 
 /// A renderer takes an earlier one's pixel cones for its own camera only, and renders with them what it
 /// renders with the cones it finds itself.

@@ -102,8 +102,9 @@ impl ConeCandidates {
             let near = (0..len).map(|i| distance_below(apex, &triangle(8 * j + i).0)).fold(f32::INFINITY, f32::min);
             (TrianglePacket::from_fn(len, |i| triangle(8 * j + i)), near)
         };
-        // The first packet is always tested (no ray has a hit before it): its bound is never needed.
-        let first = if n == 0 { (TrianglePacket::from_fn(0, &triangle), 0.0) } else { packet(0) };
+        // The first packet is always tested (no ray has a hit before it): its bound, 0, is never reached, and is
+        // not worked out (most cones, made for every pixel on every pass, hold only this packet).
+        let first = (TrianglePacket::from_fn(n.min(8), &triangle), 0.0);
         Self { apex, first, rest: (1..n.div_ceil(8)).map(packet).collect() }
     }
 
