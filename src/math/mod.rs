@@ -14,7 +14,7 @@ mod vec3x8;
 pub use denormals::without_denormals;
 pub use equal_area::{SOLID_ANGLE_PER_DISK_AREA, disk_to_hemisphere, hemisphere_to_disk};
 pub use frame::Frame;
-pub use offset::{SurfaceError, gamma, offset_ray_origin, offset_ray_origins};
+pub use offset::{SurfaceError, SurfaceErrorLanes, gamma, offset_ray_origin, offset_ray_origins};
 pub use phong_polygon::phong_polygon_moment;
 pub use polygon::lambert_polygon_irradiance;
 pub use rng::{ONE_MINUS_EPSILON, PixelStreams, SampleRng, SampleRngLanes, hash_ray, mix64};
@@ -56,6 +56,15 @@ pub fn lanes_in(set: u32, indices: wide::i32x8) -> u32 {
     let shift = indices.cmp_lt(i32x8::ZERO).blend(last, indices.min(last));
     let bit = (i32x8::splat((set & !(1 << 31)) as i32) >> shift) & i32x8::ONE;
     let on: wide::f32x8 = bytemuck::cast(bit.cmp_eq(i32x8::ONE));
+    on.move_mask() as u32
+}
+
+/// The lanes l with `values[l] == value`, as a bit mask (bit l for lane l): one vector comparison.
+#[inline(always)]
+pub fn lanes_equal(values: &[u32; 8], value: u32) -> u32 {
+    use wide::{CmpEq, i32x8};
+    let equal = i32x8::new(values.map(|v| v as i32)).cmp_eq(i32x8::splat(value as i32));
+    let on: wide::f32x8 = bytemuck::cast(equal);
     on.move_mask() as u32
 }
 

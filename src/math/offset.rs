@@ -91,6 +91,28 @@ impl SurfaceError {
     }
 }
 
+/// Eight lanes' [`SurfaceError`]s, one vector per field.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceErrorLanes {
+    pub at_point: f32x8,
+    pub per_distance: Vec3x8,
+}
+
+impl SurfaceErrorLanes {
+    /// Lane l holds `errors[l]`.
+    #[inline]
+    pub fn from_lanes(errors: &[SurfaceError; 8]) -> Self {
+        let at_point = f32x8::new(errors.map(|e| e.at_point));
+        Self { at_point, per_distance: Vec3x8::from_lanes(&errors.map(|e| e.per_distance)) }
+    }
+
+    /// [`SurfaceError::far_end`] for eight rays at once, the same values bit for bit.
+    #[inline]
+    pub fn far_end(&self, p: Vec3x8, x: Vec3x8, n_x: Vec3x8) -> f32x8 {
+        SurfaceError::far_end_lanes(self.at_point, self.per_distance, p, x, n_x)
+    }
+}
+
 /// The next float after `o` in the direction of the sign of `dir` (`o` itself where dir is 0).
 #[inline]
 fn round_away(o: f32, dir: f32) -> f32 {

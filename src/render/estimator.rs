@@ -4,7 +4,7 @@
 use super::sink::{Outcome, SampleRecord, SampleSink};
 use super::strategy::{DirectionSample, Reached, SampleContext, Target};
 use super::{RenderSettings, ShadingPoint};
-use crate::math::{SampleRng, SurfaceError, Vec3x8, lanes_in, offset_ray_origin, offset_ray_origins};
+use crate::math::{SampleRng, SurfaceErrorLanes, Vec3x8, lanes_in, offset_ray_origin, offset_ray_origins};
 use crate::scene::{EmitterSampler, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
 use wide::{CmpGt, f32x8, i32x8};
@@ -161,16 +161,14 @@ pub fn shadow_ray_ends(
 }
 
 /// The ends of eight shadow rays: [`shadow_ray_ends`] per lane, bit for bit, with lane l's far end on a triangle
-/// with bounds `far[l]`.
+/// with bounds lane l of `far`.
 #[inline]
 pub(super) fn shadow_ray_ends_lanes(
     (p, n, error): (Vec3x8, Vec3x8, f32x8),
     (x, n_x): (Vec3x8, Vec3x8),
-    far: &[SurfaceError; 8],
+    far: &SurfaceErrorLanes,
 ) -> (Vec3x8, Vec3x8) {
-    let at_point = f32x8::new(far.map(|e| e.at_point));
-    let per_distance = Vec3x8::from_lanes(&far.map(|e| e.per_distance));
-    let far = SurfaceError::far_end_lanes(at_point, per_distance, p, x, n_x);
+    let far = far.far_end(p, x, n_x);
     (offset_ray_origins(p, n, error), offset_ray_origins(x, n_x, far))
 }
 
@@ -185,7 +183,7 @@ pub(super) fn visible_lanes(
     scene: &Scene,
     near: (Vec3x8, Vec3x8, f32x8),
     (x, n_x): (Vec3x8, Vec3x8),
-    (far, groups): (&[SurfaceError; 8], [u32; 8]),
+    (far, groups): (impl FnOnce() -> SurfaceErrorLanes, [u32; 8]),
     active: u32,
     tile: Option<(&TileLights, i32x8)>,
     rays: &mut u64,
@@ -196,7 +194,7 @@ pub(super) fn visible_lanes(
     if traced == 0 {
         return active; // no ray (all missed, saw only a light, or were rejected), or only rays to clear lights
     }
-    let (from, to) = shadow_ray_ends_lanes(near, (x, n_x), far);
+    let (from, to) = shadow_ray_ends_lanes(near, (x, n_x), &far());
     let (mut occluded, mut walking) = (0, traced);
     if let Some((blockers, slots)) = tile.and_then(|(tile, slots)| Some((tile.blockers.as_deref()?, slots))) {
         let listed = traced & blockers.listed(slots);

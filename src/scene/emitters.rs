@@ -1,7 +1,7 @@
 //! Light selection: the probability p_Δ with which a light strategy picks the emissive triangle Δ.
 
 use super::{SKIP_NONE, Scene};
-use crate::math::{SurfaceError, Vec3x8, lane_mask, luminance};
+use crate::math::{SurfaceError, SurfaceErrorLanes, Vec3x8, lane_mask, luminance};
 use crate::sampling::{DiscreteDistribution, IndexSteps};
 use glam::Vec3;
 use wide::{f32x8, i32x8};
@@ -66,6 +66,8 @@ const FIELD_TABLE_SLOTS: usize = 7;
 struct FieldTable {
     steps: IndexSteps,
     fields: [f32x8; 16],
+    /// The records' offset bounds (`at_point`, then `per_distance`), as the fields are held.
+    errors: [f32x8; 4],
 }
 
 /// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
@@ -157,7 +159,12 @@ impl EmitterSampler {
         let table = distribution.steps().filter(|_| small).map(|steps| {
             let rows = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).rows();
             let field = |k: usize| f32x8::new(std::array::from_fn(|s| rows(s)[k / 8].as_array_ref()[k % 8]));
-            FieldTable { steps, fields: std::array::from_fn(field) }
+            let error = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).error;
+            let bound = |s: usize| {
+                [error(s).at_point, error(s).per_distance.x, error(s).per_distance.y, error(s).per_distance.z]
+            };
+            let errors = std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| bound(s)[k])));
+            FieldTable { steps, fields: std::array::from_fn(field), errors }
         });
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, table })
     }
@@ -192,6 +199,14 @@ impl EmitterSampler {
         let table = self.table.as_ref()?;
         let slots = lane_mask(lanes).blend(table.steps.indices(u), i32x8::splat(7));
         Some((slots, table.fields.map(|field| lane_lookup(field, slots))))
+    }
+
+    /// The offset bounds of the records in `slots` (as [`EmitterSampler::pick_fields`] gives them), where
+    /// `pick_fields` gives fields.
+    #[inline(always)]
+    pub fn picked_errors(&self, slots: i32x8) -> Option<SurfaceErrorLanes> {
+        let [at_point, x, y, z] = self.table.as_ref()?.errors.map(|field| lane_lookup(field, slots));
+        Some(SurfaceErrorLanes { at_point, per_distance: Vec3x8::new(x, y, z) })
     }
 
     /// The record of slot `slot`, for the selections that do not depend on the shading point.
@@ -307,6 +322,7 @@ mod tests {
                 };
                 let lanes = (i as u32 * 37) & 0xff;
                 if let Some((picked, fields)) = sampler.pick_fields(f32x8::new(u), lanes) {
+                    let errors = sampler.picked_errors(picked).expect("held with the fields");
                     for (l, record) in records.iter().enumerate() {
                         let on = lanes & (1 << l) != 0;
                         assert_eq!(picked.as_array_ref()[l], if on { slots[l] as i32 } else { 7 });
@@ -314,6 +330,9 @@ mod tests {
                         let rows = if on { record.rows() } else { EmitterTriangle::NONE.rows() };
                         let row = |k: usize| fields[k].as_array_ref()[l].to_bits();
                         assert!((0..16).all(|k| row(k) == rows[k / 8].as_array_ref()[k % 8].to_bits()));
+                        let error = if on { record.error } else { EmitterTriangle::NONE.error };
+                        let (at_point, per_distance) = (errors.at_point.as_array_ref()[l], errors.per_distance.lane(l));
+                        assert_eq!(SurfaceError { at_point, per_distance }, error);
                     }
                 }
                 for ((e, u), slot) in records.iter().zip(u).zip(slots) {

@@ -6,7 +6,7 @@
 //! bit.
 
 use super::{LANES, mis_brdf_technique, mis_sums};
-use crate::math::{SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, lane_mask};
+use crate::math::{SampleRngLanes, SurfaceErrorLanes, Vec3x8, for_each_lane, lane_mask, lanes_equal};
 use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
@@ -40,7 +40,7 @@ struct EmitterLanes {
     ln: Vec3x8,
     light_material: [u32; LANES],
     light_group: [u32; LANES],
-    light_error: [SurfaceError; LANES],
+    light_error: SurfaceErrorLanes,
     /// ω, p(ω) and ω·n.
     wi: Vec3x8,
     pdf: [f32; LANES],
@@ -73,7 +73,7 @@ impl EmitterLanes {
         // broadcast instead; a lane that missed holds zeros either way.
         let mut materials = [0; LANES];
         let first = hits.triangle[(hit.trailing_zeros() & 7) as usize];
-        let same = hits.triangle.iter().enumerate().fold(0, |m, (l, &t)| m | ((t == first) as u32) << l);
+        let same = lanes_equal(&hits.triangle, first);
         let ([a, b, c], [nx, ny, nz], p_error) = if hit != 0 && same & hit == hit {
             let tri = &scene.triangles[first as usize];
             for_each_lane(hit, |l| materials[l] = tri.material);
@@ -105,17 +105,16 @@ impl EmitterLanes {
         // records held in vectors are picked in f32x8 (`EmitterSampler::pick_fields`); otherwise the picked
         // records' rows transpose into one vector per field, read once every lane has picked, so that their
         // loads wait on the alias table together. A lane with no light keeps `EmitterTriangle::NONE`.
-        let mut light_error = [EmitterTriangle::NONE.error; LANES];
         let (u_light, u_point) = (rngs.uniform(), [rngs.uniform(), rngs.uniform()]);
         let mut picked = 0;
-        let (slots, [la, lb, lc], [nx, ny, nz, area, p_delta, material, group]) =
+        let (slots, [la, lb, lc], [nx, ny, nz, area, p_delta, material, group], light_error) =
             if let Some((slots, f)) = emitters.pick_fields(u_light, hit) {
-                let slot = slots.to_array();
-                for_each_lane(hit, |l| light_error[l] = emitters.record(slot[l] as usize).error);
                 picked = hit;
                 let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
-                (slots, [vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]])
+                let errors = emitters.picked_errors(slots).expect("held with the fields");
+                (slots, [vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]], errors)
             } else {
+                let mut light_error = [EmitterTriangle::NONE.error; LANES];
                 let none = EmitterTriangle::NONE.rows();
                 let (mut lo, mut hi) = ([none[0]; LANES], [none[1]; LANES]);
                 let mut slots = [-1; LANES];
@@ -137,7 +136,8 @@ impl EmitterLanes {
                     });
                 }
                 let [cz, nx, ny, nz, area, p_delta, material, group] = f32x8::transpose(hi);
-                (i32x8::new(slots), Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group])
+                let errors = SurfaceErrorLanes::from_lanes(&light_error);
+                (i32x8::new(slots), Vec3x8::triangles(lo, cz), [nx, ny, nz, area, p_delta, material, group], errors)
             };
         let ln = Vec3x8::new(nx, ny, nz);
         // The picked triangle's material (u32::MAX for none) and convex emitter group.
@@ -200,7 +200,7 @@ impl EmitterLanes {
     #[inline(always)]
     fn visible(&self, scene: &Scene, tile: &TileLights, active: u32, rays: &mut u64) -> u32 {
         let (near, far, lights) =
-            ((self.p, self.n, self.p_error), (self.x, self.ln), (&self.light_error, self.light_group));
+            ((self.p, self.n, self.p_error), (self.x, self.ln), (|| self.light_error, self.light_group));
         visible_lanes(scene, near, far, lights, active, Some((tile, self.slots)), rays)
     }
 }
@@ -220,13 +220,24 @@ pub fn estimate_emitter_lanes(
     let e = EmitterLanes::draw(scene, lights.0, dirs, hits, rngs);
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
     let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
-    for_each_lane(e.front & e.hit, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
+    // Where the lanes that see a front face all see one material (most groups), its L_e is read once (and, for a
+    // material that does not emit, not written at all).
+    let seen = e.front & e.hit;
+    let first = e.materials[(seen.trailing_zeros() & 7) as usize];
+    if seen & lanes_equal(&e.materials, first) == seen {
+        let le = scene.materials[first as usize].emission;
+        if le != Vec3::ZERO {
+            for_each_lane(seen, |l| emitted[l] = le);
+        }
+    } else {
+        for_each_lane(seen, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
+    }
     let mut shadow_rays = 0;
     let light = e.ok & e.picked;
     // Where every such lane shades one diffuse material (most groups), f_r = k_d/π wherever n·ω_o > 0 (n·ω > 0
     // is in `ok`), as `eval_brdf` gives it, and the value is computed in f32x8; lane by lane elsewhere.
     let m = e.materials[(light.trailing_zeros() & 7) as usize];
-    let alike = (0..LANES).fold(0, |a, l| a | ((e.materials[l] == m) as u32) << l);
+    let alike = lanes_equal(&e.materials, m);
     // Lane 0's material where no lane picked a light: a scene with emitters has materials.
     let material = &scene.materials[m as usize];
     if light != 0 && alike & light == light && material.ks == Vec3::ZERO {
@@ -235,7 +246,7 @@ pub fn estimate_emitter_lanes(
         // light material (a scene with one light) is broadcast, several gathered.
         let emission = |l: usize| scene.materials[e.light_material[l] as usize].emission;
         let lm = e.light_material[(light.trailing_zeros() & 7) as usize];
-        let one_light = (0..LANES).all(|l| light & (1 << l) == 0 || e.light_material[l] == lm);
+        let one_light = light & !lanes_equal(&e.light_material, lm) == 0;
         let (li, lit) = if one_light {
             let li = scene.materials[lm as usize].emission;
             (Vec3x8::splat(li), if li != Vec3::ZERO { light } else { 0 })

@@ -20,7 +20,9 @@ use super::estimator::{integrand, unshadowed, visible_lanes};
 use super::sink::{Outcome, SampleRecord};
 use super::strategy::{DirectionSample, Reached, SampleContext, Technique};
 use super::{ShadingPoint, Target};
-use crate::math::{SampleRng, SampleRngLanes, SurfaceError, Vec3x8, for_each_lane, offset_ray_origins};
+use crate::math::{
+    SampleRng, SampleRngLanes, SurfaceError, SurfaceErrorLanes, Vec3x8, for_each_lane, offset_ray_origins,
+};
 use crate::scene::{Hit, HitLanes, Material, SKIP_NONE, Scene, TileLights};
 use glam::Vec3;
 use wide::{f32x8, i32x8};
@@ -166,7 +168,8 @@ impl ShadowRays {
         let slot = |t: u32| scene.emitters.iter().position(|&e| e == t).map_or(-1, |s| s as i32);
         let known = tile.clear != 0 || tile.blockers.is_some();
         let tile = known.then(|| (tile, i32x8::new(self.lights.map(slot))));
-        visible_lanes(scene, near, (x, n_x), (&self.light_error, self.groups), self.lanes, tile, rays)
+        let far = || SurfaceErrorLanes::from_lanes(&self.light_error);
+        visible_lanes(scene, near, (x, n_x), (far, self.groups), self.lanes, tile, rays)
     }
 }
 

@@ -167,7 +167,7 @@ impl TrianglePacket {
             };
             outside |= below(&corners[0]) & below(&corners[1]) & below(&corners[2]);
         }
-        let unused = self.ids.iter().enumerate().fold(0, |m, (l, &id)| m | ((id == u32::MAX) as u32) << l);
+        let unused = crate::math::lanes_equal(&self.ids, u32::MAX);
         !(outside.move_mask() as u32) & !unused & 0xff
     }
 }

@@ -40,7 +40,7 @@ impl NearestLanes {
     #[inline(always)]
     pub fn hits(&self) -> HitLanes {
         let triangle = self.id.to_array().map(f32::to_bits);
-        let mask = triangle.iter().enumerate().fold(0, |m, (l, &id)| m | ((id != u32::MAX) as u32) << l);
+        let mask = !crate::math::lanes_equal(&triangle, u32::MAX) & 0xff;
         HitLanes { mask, triangle, t: self.t, u: self.u, v: self.v }
     }
 }

@@ -134,7 +134,7 @@ impl TrianglePacket {
             let d = f32x8::splat(d);
             cleared |= dot(n, *v0).cmp_le(d) & dot(n, v1).cmp_le(d) & dot(n, v2).cmp_le(d);
         }
-        let unused = self.ids.iter().enumerate().fold(0, |m, (l, &id)| m | ((id == u32::MAX) as u32) << l);
+        let unused = crate::math::lanes_equal(&self.ids, u32::MAX);
         cleared.move_mask() as u32 | unused
     }
 }
