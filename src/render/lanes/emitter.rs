@@ -150,7 +150,7 @@ impl EmitterLanes {
         let x = la * b0 + lb * b1 + lc * (f32x8::ONE - b0 - b1);
         let d = x - p;
         let dist = d.length();
-        let wi = d / dist;
+        let wi = d * (f32x8::ONE / dist);
         let cos_light = ln.dot(-wi);
         let pdf = p_delta * (dist * dist / (area * cos_light));
         let cos = n.dot(wi);
@@ -219,19 +219,20 @@ pub fn estimate_emitter_lanes(
 ) -> [Vec3; LANES] {
     let e = EmitterLanes::draw(scene, lights.0, dirs, hits, rngs);
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
-    let (mut emitted, mut reflected) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
+    let zero = Vec3x8::splat(Vec3::ZERO);
     // Where the lanes that see a front face all see one material (most groups), its L_e is read once (and, for a
-    // material that does not emit, not written at all).
+    // material that does not emit, not used at all).
     let seen = e.front & e.hit;
     let first = e.materials[(seen.trailing_zeros() & 7) as usize];
-    if seen & lanes_equal(&e.materials, first) == seen {
+    let emitted = if seen & lanes_equal(&e.materials, first) == seen {
         let le = scene.materials[first as usize].emission;
-        if le != Vec3::ZERO {
-            for_each_lane(seen, |l| emitted[l] = le);
-        }
+        if le == Vec3::ZERO { zero } else { Vec3x8::select(cast(lane_mask(seen)), Vec3x8::splat(le), zero) }
     } else {
+        let mut emitted = [Vec3::ZERO; LANES];
         for_each_lane(seen, |l| emitted[l] = scene.materials[e.materials[l] as usize].emission);
-    }
+        Vec3x8::from_lanes(&emitted)
+    };
+    let mut reflected = zero;
     let mut shadow_rays = 0;
     let light = e.ok & e.picked;
     // Where every such lane shades one diffuse material (most groups), f_r = k_d/π wherever n·ω_o > 0 (n·ω > 0
@@ -260,22 +261,24 @@ pub fn estimate_emitter_lanes(
         };
         if f != Vec3::ZERO {
             shadow_rays = lit & e.n.dot(e.wo).cmp_gt(f32x8::ZERO).move_mask() as u32;
-            reflected = (Vec3x8::splat(f) * li * f32x8::new(e.cos) / f32x8::new(e.pdf)).to_lanes();
+            reflected = Vec3x8::splat(f) * li * f32x8::new(e.cos) / f32x8::new(e.pdf);
         }
     } else {
+        let mut each = [Vec3::ZERO; LANES];
         for_each_lane(light, |l| {
             let material = &scene.materials[e.materials[l] as usize];
             let wi = e.wi.lane(l);
             let f = material.eval_brdf(e.n.lane(l), e.wo.lane(l), wi);
             let li = scene.materials[e.light_material[l] as usize].emission;
             if f != Vec3::ZERO && li != Vec3::ZERO {
-                reflected[l] = f * li * e.cos[l] / e.pdf[l];
+                each[l] = f * li * e.cos[l] / e.pdf[l];
                 shadow_rays |= 1 << l;
             }
         });
+        reflected = Vec3x8::from_lanes(&each);
     }
     let visible = e.visible(scene, lights.1, shadow_rays, rays);
-    std::array::from_fn(|l| emitted[l] + if visible & (1 << l) != 0 { reflected[l] } else { Vec3::ZERO })
+    (emitted + Vec3x8::select(cast(lane_mask(visible)), reflected, zero)).to_lanes()
 }
 
 /// MIS of emitter sampling and BRDF sampling, one direction each (the default `MisSettings`), for up to eight

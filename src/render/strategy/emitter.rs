@@ -20,7 +20,7 @@ impl TriangleSampler for Emitter {
         if !(dist > 0.0) {
             return None;
         }
-        let wi = d / dist;
+        let wi = d * dist.recip();
         let cos_light = tri.n.dot(-wi);
         if !(cos_light > 0.0) {
             return None;
