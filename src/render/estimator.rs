@@ -174,7 +174,8 @@ pub(super) fn shadow_ray_ends_lanes(
 
 /// [`visible`] for eight pairs of points at once, one per lane, those in `active` (bit i for lane i): the
 /// shading points (p, n, their bounds), the points x on the lights with their normals, lane i's x on a triangle
-/// with bounds `far[i]` of convex emitter group `groups[i]` ([`SKIP_NONE`] for none); returns the visible ones.
+/// with the bounds in lane i of `far()` (asked for only where a ray is traced) and of convex emitter group
+/// `groups[i]` ([`SKIP_NONE`] for none); returns the visible ones.
 /// With `tile` (the pixel's tile, and each lane's emitter slot), the rays to its clear lights get through untraced
 /// and those to a light its blockers list meet them alone; the others walk the tree. Lane i's answer is
 /// `visible`'s, bit for bit.

@@ -209,12 +209,6 @@ impl EmitterSampler {
         Some(SurfaceErrorLanes { at_point, per_distance: Vec3x8::new(x, y, z) })
     }
 
-    /// The record of slot `slot`, for the selections that do not depend on the shading point.
-    #[inline(always)]
-    pub fn record(&self, slot: usize) -> &EmitterTriangle {
-        &self.records[slot]
-    }
-
     /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
     /// emit.
     #[inline]
@@ -326,7 +320,7 @@ mod tests {
                     for (l, record) in records.iter().enumerate() {
                         let on = lanes & (1 << l) != 0;
                         assert_eq!(picked.as_array_ref()[l], if on { slots[l] as i32 } else { 7 });
-                        assert!(std::ptr::eq(sampler.record(slots[l]), *record));
+                        assert!(std::ptr::eq(&sampler.records[slots[l]], *record));
                         let rows = if on { record.rows() } else { EmitterTriangle::NONE.rows() };
                         let row = |k: usize| fields[k].as_array_ref()[l].to_bits();
                         assert!((0..16).all(|k| row(k) == rows[k / 8].as_array_ref()[k % 8].to_bits()));
