@@ -80,15 +80,6 @@ impl SurfaceError {
         let from = p.x.abs() * n_x.x.abs() + p.y.abs() * n_x.y.abs() + p.z.abs() * n_x.z.abs();
         self.at_point + segment + gamma(8) * from
     }
-
-    /// [`SurfaceError::far_end`] for eight rays at once, the same values bit for bit.
-    #[inline]
-    pub fn far_end_lanes(at_point: f32x8, per_distance: Vec3x8, p: Vec3x8, x: Vec3x8, n_x: Vec3x8) -> f32x8 {
-        let (d, w) = (x - p, per_distance);
-        let segment = d.x.abs() * w.x + d.y.abs() * w.y + d.z.abs() * w.z;
-        let from = p.x.abs() * n_x.x.abs() + p.y.abs() * n_x.y.abs() + p.z.abs() * n_x.z.abs();
-        at_point + segment + f32x8::splat(gamma(8)) * from
-    }
 }
 
 /// Eight lanes' [`SurfaceError`]s, one vector per field.
@@ -109,7 +100,10 @@ impl SurfaceErrorLanes {
     /// [`SurfaceError::far_end`] for eight rays at once, the same values bit for bit.
     #[inline]
     pub fn far_end(&self, p: Vec3x8, x: Vec3x8, n_x: Vec3x8) -> f32x8 {
-        SurfaceError::far_end_lanes(self.at_point, self.per_distance, p, x, n_x)
+        let (d, w) = (x - p, self.per_distance);
+        let segment = d.x.abs() * w.x + d.y.abs() * w.y + d.z.abs() * w.z;
+        let from = p.x.abs() * n_x.x.abs() + p.y.abs() * n_x.y.abs() + p.z.abs() * n_x.z.abs();
+        self.at_point + segment + f32x8::splat(gamma(8)) * from
     }
 }
 
@@ -245,13 +239,9 @@ mod tests {
             let (p, x) = (Vec3::new(v(), v(), v()) * scale, Vec3::new(v(), v(), v()) * scale);
             let n = Vec3::new(v(), v(), v()).normalize_or(Vec3::Z);
             let e = SurfaceError { at_point: v().abs() * 1e-6, per_distance: Vec3::new(v(), v(), v()).abs() * 1e-6 };
-            let lanes = SurfaceError::far_end_lanes(
-                f32x8::splat(e.at_point),
-                Vec3x8::splat(e.per_distance),
-                Vec3x8::splat(p),
-                Vec3x8::splat(x),
-                Vec3x8::splat(n),
-            );
+            let errors =
+                SurfaceErrorLanes { at_point: f32x8::splat(e.at_point), per_distance: Vec3x8::splat(e.per_distance) };
+            let lanes = errors.far_end(Vec3x8::splat(p), Vec3x8::splat(x), Vec3x8::splat(n));
             assert_eq!(lanes.as_array_ref()[i % 8].to_bits(), e.far_end(p, x, n).to_bits());
         }
     }

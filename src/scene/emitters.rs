@@ -191,22 +191,16 @@ impl EmitterSampler {
     }
 
     /// What [`EmitterSampler::pick`] picks for eight uniforms, in the lanes of `lanes` (bit l for lane l): the
-    /// slot picked with `u`'s lane l in lane l (7 in the other lanes), and field k ([`EmitterTriangle::rows`]'
-    /// k-th value) of its record ([`EmitterTriangle::NONE`]'s in the other lanes). `None` where the records are
-    /// not held in vectors (more than seven, or a selection that depends on the shading point).
+    /// slot picked with `u`'s lane l in lane l (7 in the other lanes), field k ([`EmitterTriangle::rows`]' k-th
+    /// value) of its record and its offset bounds ([`EmitterTriangle::NONE`]'s in the other lanes). `None` where
+    /// the records are not held in vectors (more than seven, or a selection that depends on the shading point).
     #[inline(always)]
-    pub fn pick_fields(&self, u: f32x8, lanes: u32) -> Option<(i32x8, [f32x8; 16])> {
+    pub fn pick_fields(&self, u: f32x8, lanes: u32) -> Option<(i32x8, [f32x8; 16], SurfaceErrorLanes)> {
         let table = self.table.as_ref()?;
         let slots = lane_mask(lanes).blend(table.steps.indices(u), i32x8::splat(7));
-        Some((slots, table.fields.map(|field| lane_lookup(field, slots))))
-    }
-
-    /// The offset bounds of the records in `slots` (as [`EmitterSampler::pick_fields`] gives them), where
-    /// `pick_fields` gives fields.
-    #[inline(always)]
-    pub fn picked_errors(&self, slots: i32x8) -> Option<SurfaceErrorLanes> {
-        let [at_point, x, y, z] = self.table.as_ref()?.errors.map(|field| lane_lookup(field, slots));
-        Some(SurfaceErrorLanes { at_point, per_distance: Vec3x8::new(x, y, z) })
+        let [at_point, x, y, z] = table.errors.map(|field| lane_lookup(field, slots));
+        let errors = SurfaceErrorLanes { at_point, per_distance: Vec3x8::new(x, y, z) };
+        Some((slots, table.fields.map(|field| lane_lookup(field, slots)), errors))
     }
 
     /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
@@ -315,8 +309,7 @@ mod tests {
                     continue;
                 };
                 let lanes = (i as u32 * 37) & 0xff;
-                if let Some((picked, fields)) = sampler.pick_fields(f32x8::new(u), lanes) {
-                    let errors = sampler.picked_errors(picked).expect("held with the fields");
+                if let Some((picked, fields, errors)) = sampler.pick_fields(f32x8::new(u), lanes) {
                     for (l, record) in records.iter().enumerate() {
                         let on = lanes & (1 << l) != 0;
                         assert_eq!(picked.as_array_ref()[l], if on { slots[l] as i32 } else { 7 });

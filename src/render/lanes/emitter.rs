@@ -108,10 +108,9 @@ impl EmitterLanes {
         let (u_light, u_point) = (rngs.uniform(), [rngs.uniform(), rngs.uniform()]);
         let mut picked = 0;
         let (slots, [la, lb, lc], [nx, ny, nz, area, p_delta, material, group], light_error) =
-            if let Some((slots, f)) = emitters.pick_fields(u_light, hit) {
+            if let Some((slots, f, errors)) = emitters.pick_fields(u_light, hit) {
                 picked = hit;
                 let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
-                let errors = emitters.picked_errors(slots).expect("held with the fields");
                 (slots, [vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]], errors)
             } else {
                 let mut light_error = [EmitterTriangle::NONE.error; LANES];
