@@ -215,7 +215,7 @@ pub fn estimate_emitter_lanes(
     hits: &HitLanes,
     rngs: &mut SampleRngLanes,
     rays: &mut u64,
-) -> [Vec3; LANES] {
+) -> Vec3x8 {
     let e = EmitterLanes::draw(scene, lights.0, dirs, hits, rngs);
     // Per lane: L_e towards the camera, and f_r L_i (ω·n) / p(ω) if the shadow ray gets through.
     let zero = Vec3x8::splat(Vec3::ZERO);
@@ -277,7 +277,7 @@ pub fn estimate_emitter_lanes(
         reflected = Vec3x8::from_lanes(&each);
     }
     let visible = e.visible(scene, lights.1, shadow_rays, rays);
-    (emitted + Vec3x8::select(cast(lane_mask(visible)), reflected, zero)).to_lanes()
+    emitted + Vec3x8::select(cast(lane_mask(visible)), reflected, zero)
 }
 
 /// MIS of emitter sampling and BRDF sampling, one direction each (the default `MisSettings`), for up to eight

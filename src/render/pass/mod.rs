@@ -10,7 +10,7 @@ use super::sink::{Census, Learner, SampleRecord, SampleSink};
 use super::strategy::{Brdf, Emitter, ProjectedSolidAngle, SampleContext, SolidAngle, StrategyState};
 use super::{Film, Footprint, PixelAccum, PixelCones, ShadingPoint, Strategy};
 use crate::guiding::{Guide, GuideRecord, LeafHint, Training};
-use crate::math::{PixelStreams, SampleRng, without_denormals};
+use crate::math::{PixelStreams, SampleRng, Vec3x8, without_denormals};
 use crate::scene::{Camera, CameraBasis, ConeCandidates, EmitterSampler, Hit, HitLanes, Scene, TileLights};
 use cpu_time::ThreadTime;
 use glam::Vec3;
@@ -258,6 +258,8 @@ impl Renderer {
                 // Made here, where it is used: moved through the rows' iterators it was copied each time.
                 let cone = ids.map(|ids| self.scene.cone(self.camera.eye(), ids));
                 let streams = streams(x);
+                // The pixel's sums stay in vectors over its groups (`PixelSums`).
+                let mut sums = acc.sums();
                 for group in (first..first + count).step_by(LANES) {
                     let samples = group..(group + LANES as u32).min(first + count);
                     let n = samples.len();
@@ -266,10 +268,14 @@ impl Renderer {
                     let cone = (cone.as_ref(), tile);
                     let values = self.sample_lanes(pixel, &streams, samples, cone, &mut rays, learned);
                     if keep {
-                        stats.non_finite += acc.add_finite(&values[..n]);
+                        stats.non_finite += sums.add_lanes(&values, n);
                     } else {
-                        stats.non_finite += values[..n].iter().filter(|v| !v.is_finite()).count() as u64;
+                        let finite = values.x.is_finite() & values.y.is_finite() & values.z.is_finite();
+                        stats.non_finite += (!finite.move_mask() as u32 & ((1 << n) - 1)).count_ones() as u64;
                     }
+                }
+                if keep {
+                    sums.store(acc);
                 }
             }
         }
@@ -336,7 +342,7 @@ impl Renderer {
         (cone, tile): (Option<&ConeCandidates>, &TileLights),
         rays: &mut u64,
         mut learned: Option<&mut Vec<GuideRecord>>,
-    ) -> [Vec3; LANES] {
+    ) -> Vec3x8 {
         let n = samples.len();
         let mut rngs = streams.samples(samples.start as u64);
         let footprint = self.settings.footprint;
@@ -359,9 +365,9 @@ impl Renderer {
         };
         *rays += n as u64;
         let strategy = self.settings.strategy;
-        match (strategy, &self.emitters) {
+        let values = match (strategy, &self.emitters) {
             (Strategy::Emitter, Some(emitters)) => {
-                estimate_emitter_lanes(&self.scene, (emitters, tile), &dirs, &hits, &mut rngs, rays)
+                return estimate_emitter_lanes(&self.scene, (emitters, tile), &dirs, &hits, &mut rngs, rays);
             }
             (_, Some(_)) if strategy.samples_lights() => {
                 let mut rngs = std::array::from_fn(|l| rngs.lane(l));
@@ -433,7 +439,8 @@ impl Renderer {
                     })
                 })
             }
-        }
+        };
+        Vec3x8::from_lanes(&values)
     }
 
     /// One sample of `L = L_e(x, ω_o) + ∫ f_r L_i (ω·n) dω` at the first surface x seen along the camera ray `dir`;
