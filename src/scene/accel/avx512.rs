@@ -36,14 +36,14 @@ pub(super) struct RayLanes512 {
     o: [__m512; 3],
     d: [__m512; 3],
     inv_d: [__m512; 3],
-    /// Per axis, the lanes whose ray travels towards −axis.
+    /// Per axis, the lanes whose ray travels towards −axis (the sign bits of 1/d).
     negative: [__mmask16; 3],
 }
 
 impl RayLanes512 {
     #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
     fn new(rays: &RayLanes) -> Self {
-        let negative = rays.negative.map(|n| _mm512_movepi32_mask(_mm512_castps_si512(twice(n))));
+        let negative = rays.inv_d.map(|v| _mm512_movepi32_mask(_mm512_castps_si512(twice(v))));
         Self { o: rays.o.map(|v| twice(v)), d: rays.d.map(|v| twice(v)), inv_d: rays.inv_d.map(|v| twice(v)), negative }
     }
 }

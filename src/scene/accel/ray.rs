@@ -15,11 +15,6 @@ pub(super) struct WideRay {
     pub o: [f32x8; 3],
     pub d: [f32x8; 3],
     pub inv_d: [f32x8; 3],
-    /// Per axis, all bits set where the ray travels towards −axis (it enters a box by its max plane): the slab
-    /// test picks each box's entry and exit planes with a blend. Picked by an index per axis instead (a load and an
-    /// address each), the knot's shadow-ray walks took 100.1 M instructions against 92.9 M (callgrind, `emitter`,
-    /// 128², 16 spp; 112.3 M with the indices' bounds checked).
-    pub negative: [f32x8; 3],
 }
 
 impl WideRay {
@@ -29,12 +24,7 @@ impl WideRay {
         let tiny = d.abs().cmplt(Vec3A::splat(MIN_COMPONENT));
         let inv_d =
             Vec3A::select(tiny, Vec3A::splat(MIN_COMPONENT).copysign(d), d).recip().to_array().map(f32x8::splat);
-        Self {
-            o: origin.to_array().map(f32x8::splat),
-            d: dir.to_array().map(f32x8::splat),
-            inv_d,
-            negative: inv_d.map(sign_mask),
-        }
+        Self { o: origin.to_array().map(f32x8::splat), d: dir.to_array().map(f32x8::splat), inv_d }
     }
 }
 
@@ -43,8 +33,6 @@ pub(super) struct RayLanes {
     pub o: [f32x8; 3],
     pub d: [f32x8; 3],
     pub inv_d: [f32x8; 3],
-    /// Per axis, all bits set in the lanes whose ray travels towards −axis (it enters a box by its max plane).
-    pub negative: [f32x8; 3],
 }
 
 impl RayLanes {
@@ -55,14 +43,8 @@ impl RayLanes {
             let tiny = d.abs().cmp_lt(f32x8::splat(MIN_COMPONENT));
             f32x8::ONE / tiny.blend(f32x8::splat(MIN_COMPONENT).copysign(d), d)
         });
-        Self { o: [origins.x, origins.y, origins.z], d, inv_d, negative: inv_d.map(sign_mask) }
+        Self { o: [origins.x, origins.y, origins.z], d, inv_d }
     }
-}
-
-/// Each lane's sign bit spread over the lane (all bits set where it is negative): an arithmetic shift of the bits.
-#[inline(always)]
-fn sign_mask(v: f32x8) -> f32x8 {
-    bytemuck::cast(bytemuck::cast::<f32x8, wide::i32x8>(v) >> 31)
 }
 
 /// The tests the eight rays of a shared walk (`Accel::occluded_lanes`) run at its nodes and leaves: in eight
