@@ -68,6 +68,20 @@ struct FieldTable {
     fields: [f32x8; 16],
     /// The records' offset bounds (`at_point`, then `per_distance`), as the fields are held.
     errors: [f32x8; 4],
+    /// The emitted radiance L_e of each record's material (x, y, z), zero for [`EmitterTriangle::NONE`].
+    emission: [f32x8; 3],
+}
+
+/// Eight lanes' picks with the picked records read from a [`FieldTable`] ([`EmitterSampler::pick_fields`]).
+pub struct PickedFields {
+    /// The slot picked in each lane (7 in the lanes that pick nothing).
+    pub slots: i32x8,
+    /// Field k of each picked record's rows ([`EmitterTriangle::rows`]) in vector k.
+    pub fields: [f32x8; 16],
+    /// The picked records' offset bounds.
+    pub errors: SurfaceErrorLanes,
+    /// The emitted radiance L_e of each picked triangle's material (zero where nothing is picked).
+    pub emission: Vec3x8,
 }
 
 /// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
@@ -164,7 +178,9 @@ impl EmitterSampler {
                 [error(s).at_point, error(s).per_distance.x, error(s).per_distance.y, error(s).per_distance.z]
             };
             let errors = std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| bound(s)[k])));
-            FieldTable { steps, fields: std::array::from_fn(field), errors }
+            let le = |s: usize| records.get(s).map_or(Vec3::ZERO, |r| scene.materials[r.material as usize].emission);
+            let emission = std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| le(s)[k])));
+            FieldTable { steps, fields: std::array::from_fn(field), errors, emission }
         });
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, table })
     }
@@ -192,15 +208,18 @@ impl EmitterSampler {
 
     /// What [`EmitterSampler::pick`] picks for eight uniforms, in the lanes of `lanes` (bit l for lane l): the
     /// slot picked with `u`'s lane l in lane l (7 in the other lanes), field k ([`EmitterTriangle::rows`]' k-th
-    /// value) of its record and its offset bounds ([`EmitterTriangle::NONE`]'s in the other lanes). `None` where
-    /// the records are not held in vectors (more than seven, or a selection that depends on the shading point).
+    /// value) of its record, its offset bounds and its material's L_e ([`EmitterTriangle::NONE`]'s, and no
+    /// light, in the other lanes). `None` where the records are not held in vectors (more than seven, or a
+    /// selection that depends on the shading point).
     #[inline(always)]
-    pub fn pick_fields(&self, u: f32x8, lanes: u32) -> Option<(i32x8, [f32x8; 16], SurfaceErrorLanes)> {
+    pub fn pick_fields(&self, u: f32x8, lanes: u32) -> Option<PickedFields> {
         let table = self.table.as_ref()?;
         let slots = lane_mask(lanes).blend(table.steps.indices(u), i32x8::splat(7));
         let [at_point, x, y, z] = table.errors.map(|field| lane_lookup(field, slots));
         let errors = SurfaceErrorLanes { at_point, per_distance: Vec3x8::new(x, y, z) };
-        Some((slots, table.fields.map(|field| lane_lookup(field, slots)), errors))
+        let [r, g, b] = table.emission.map(|field| lane_lookup(field, slots));
+        let fields = table.fields.map(|field| lane_lookup(field, slots));
+        Some(PickedFields { slots, fields, errors, emission: Vec3x8::new(r, g, b) })
     }
 
     /// The slot of the scene's triangle `triangle` (its place in `Scene::emitters`), u32::MAX where it does not
@@ -309,7 +328,9 @@ mod tests {
                     continue;
                 };
                 let lanes = (i as u32 * 37) & 0xff;
-                if let Some((picked, fields, errors)) = sampler.pick_fields(f32x8::new(u), lanes) {
+                if let Some(PickedFields { slots: picked, fields, errors, emission }) =
+                    sampler.pick_fields(f32x8::new(u), lanes)
+                {
                     for (l, record) in records.iter().enumerate() {
                         let on = lanes & (1 << l) != 0;
                         assert_eq!(picked.as_array_ref()[l], if on { slots[l] as i32 } else { 7 });
@@ -320,6 +341,8 @@ mod tests {
                         let error = if on { record.error } else { EmitterTriangle::NONE.error };
                         let (at_point, per_distance) = (errors.at_point.as_array_ref()[l], errors.per_distance.lane(l));
                         assert_eq!(SurfaceError { at_point, per_distance }, error);
+                        let le = if on { scene.materials[record.material as usize].emission } else { Vec3::ZERO };
+                        assert_eq!(emission.lane(l).to_array().map(f32::to_bits), le.to_array().map(f32::to_bits));
                     }
                 }
                 for ((e, u), slot) in records.iter().zip(u).zip(slots) {

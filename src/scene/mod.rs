@@ -30,7 +30,7 @@ pub use bundled::{BUNDLED_SCENES, DEFAULT_SCENE};
 pub use camera::{Camera, CameraBasis};
 pub use disk_cache::{DiskCache, user_cache_folder};
 pub use emitter_tree::EmitterTree;
-pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection};
+pub use emitters::{EmitterSampler, EmitterTriangle, LightSelection, PickedFields};
 pub use error::SceneError;
 pub use file::{MaterialOverride, SceneFile};
 pub use load::{load_scene, load_scene_file, load_scene_from_bytes};

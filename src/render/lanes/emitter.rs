@@ -11,7 +11,7 @@ use crate::render::ShadingPoint;
 use crate::render::estimator::visible_lanes;
 use crate::render::strategy::mis::technique_context;
 use crate::render::strategy::{Brdf, Emitter, SampleContext, Technique};
-use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, Scene, TileLights};
+use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, PickedFields, Scene, TileLights};
 use bytemuck::cast;
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -41,6 +41,8 @@ struct EmitterLanes {
     light_material: [u32; LANES],
     light_group: [u32; LANES],
     light_error: SurfaceErrorLanes,
+    /// The picked triangles' L_e, where the picks were read from vectors (`EmitterSampler::pick_fields`).
+    light_emission: Option<Vec3x8>,
     /// ω, p(ω) and ω·n.
     wi: Vec3x8,
     pdf: [f32; LANES],
@@ -106,10 +108,10 @@ impl EmitterLanes {
         // records' rows transpose into one vector per field, read once every lane has picked, so that their
         // loads wait on the alias table together. A lane with no light keeps `EmitterTriangle::NONE`.
         let (u_light, u_point) = (rngs.uniform(), [rngs.uniform(), rngs.uniform()]);
-        let mut picked = 0;
+        let (mut picked, mut light_emission) = (0, None);
         let (slots, [la, lb, lc], [nx, ny, nz, area, p_delta, material, group], light_error) =
-            if let Some((slots, f, errors)) = emitters.pick_fields(u_light, hit) {
-                picked = hit;
+            if let Some(PickedFields { slots, fields: f, errors, emission }) = emitters.pick_fields(u_light, hit) {
+                (picked, light_emission) = (hit, Some(emission));
                 let vertex = |k: usize| Vec3x8::new(f[k], f[k + 1], f[k + 2]);
                 (slots, [vertex(0), vertex(3), vertex(6)], [f[9], f[10], f[11], f[12], f[13], f[14], f[15]], errors)
             } else {
@@ -176,6 +178,7 @@ impl EmitterLanes {
             light_material,
             light_group,
             light_error,
+            light_emission,
             slots,
             wi,
             pdf: pdf.to_array(),
@@ -242,12 +245,16 @@ pub fn estimate_emitter_lanes(
     let material = &scene.materials[m as usize];
     if light != 0 && alike & light == light && material.ks == Vec3::ZERO {
         let f = material.kd * FRAC_1_PI;
-        // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`. One
-        // light material (a scene with one light) is broadcast, several gathered.
+        // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`. Read
+        // with the picks where they came from vectors; else one light material (a scene with one light) is
+        // broadcast, several gathered.
         let emission = |l: usize| scene.materials[e.light_material[l] as usize].emission;
         let lm = e.light_material[(light.trailing_zeros() & 7) as usize];
         let one_light = light & !lanes_equal(&e.light_material, lm) == 0;
-        let (li, lit) = if one_light {
+        let (li, lit) = if let Some(li) = e.light_emission {
+            let zero = li.x.cmp_eq(f32x8::ZERO) & li.y.cmp_eq(f32x8::ZERO) & li.z.cmp_eq(f32x8::ZERO);
+            (li, light & !(zero.move_mask() as u32))
+        } else if one_light {
             let li = scene.materials[lm as usize].emission;
             (Vec3x8::splat(li), if li != Vec3::ZERO { light } else { 0 })
         } else {
