@@ -6,9 +6,9 @@
 //! first: each ray of the bundle then costs a packet test or a few instead of a traversal, and a packet none of
 //! whose triangles can be nearer than every ray's hit so far is not tested (nor any after it).
 
+use super::apex_packet::ApexPacket;
 use super::node::Child;
 use super::packet::{NearestLanes, TrianglePacket};
-use super::ray::WideRay;
 use super::traverse::STACK;
 use super::{Accel, Hit, HitLanes};
 use crate::math::Vec3x8;
@@ -27,9 +27,8 @@ pub const MAX_CONE: usize = 128;
 /// with a lower bound of the distance from the apex to its triangles: the first packet in place, any others apart
 /// (a cone is made for each pixel, and most hold one packet).
 pub struct ConeCandidates {
-    apex: Vec3,
-    first: (TrianglePacket, f32),
-    rest: Vec<(TrianglePacket, f32)>,
+    first: (ApexPacket, f32),
+    rest: Vec<(ApexPacket, f32)>,
 }
 
 /// The ids of the triangles a cone can hit: 4 bytes a triangle, small enough to keep for every pixel of an
@@ -100,17 +99,17 @@ impl ConeCandidates {
         let packet = |j: usize| {
             let len = (n - 8 * j).min(8);
             let near = (0..len).map(|i| distance_below(apex, &triangle(8 * j + i).0)).fold(f32::INFINITY, f32::min);
-            (TrianglePacket::from_fn(len, |i| triangle(8 * j + i)), near)
+            (ApexPacket::new(&TrianglePacket::from_fn(len, |i| triangle(8 * j + i)), apex), near)
         };
         // The first packet is always tested (no ray has a hit before it): its bound, 0, is never reached, and is
         // not worked out (most cones, made for every pixel on every pass, hold only this packet).
-        let first = (TrianglePacket::from_fn(n.min(8), &triangle), 0.0);
-        Self { apex, first, rest: (1..n.div_ceil(8)).map(packet).collect() }
+        let first = (ApexPacket::new(&TrianglePacket::from_fn(n.min(8), &triangle), apex), 0.0);
+        Self { first, rest: (1..n.div_ceil(8)).map(packet).collect() }
     }
 
     /// The packets, in order, with their distances.
     #[inline(always)]
-    fn packets(&self) -> impl Iterator<Item = &(TrianglePacket, f32)> {
+    fn packets(&self) -> impl Iterator<Item = &(ApexPacket, f32)> {
         std::iter::once(&self.first).chain(&self.rest)
     }
 
@@ -118,13 +117,12 @@ impl ConeCandidates {
     /// [`Accel::closest_hit`] finds.
     #[inline]
     pub fn closest_hit(&self, dir: Vec3, t_max: f32) -> Option<Hit> {
-        let ray = WideRay::new(self.apex, dir);
         let (length, mut best, mut limit) = (dir.length(), None, t_max);
         for (packet, near) in self.packets() {
             if limit * length <= *near {
                 break; // nothing in this packet or after it is nearer than the hit or the limit
             }
-            if let Some(h) = packet.closest(&ray, limit) {
+            if let Some(h) = packet.closest(dir, limit) {
                 (best, limit) = (Some(Hit { triangle: packet.ids[h.lane], t: h.t, u: h.u, v: h.v }), h.t);
             }
         }
@@ -136,14 +134,14 @@ impl ConeCandidates {
     #[inline]
     pub fn closest_hits(&self, dirs: &Vec3x8, active: f32x8, t_max: f32) -> HitLanes {
         let mut nearest = NearestLanes::new(t_max);
-        let (o, d) = (self.apex.to_array().map(f32x8::splat), [dirs.x, dirs.y, dirs.z]);
+        let d = [dirs.x, dirs.y, dirs.z];
         let (length, inactive) = (dirs.length(), !active);
         for (packet, near) in self.packets() {
             // Every active ray has a hit no further than anything in this packet can be.
             if ((nearest.t * length).cmp_le(f32x8::splat(*near)) | inactive).all() {
                 break;
             }
-            packet.nearer_of_rays(&o, &d, active, &mut nearest);
+            packet.nearer_of_rays(&d, active, &mut nearest);
         }
         nearest.hits()
     }

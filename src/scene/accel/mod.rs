@@ -7,6 +7,7 @@
 //! sees too many triangles for one, its camera rays walk the tree as one packet.
 
 #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+mod apex_packet;
 mod avx512;
 mod blockers;
 mod build;

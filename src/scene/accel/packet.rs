@@ -19,6 +19,31 @@ pub(super) struct LaneHit {
     pub v: f32,
 }
 
+impl LaneHit {
+    /// The nearest of the lanes of `mask` (bit i for lane i) hit at `0 < t < t_max`, from Möller–Trumbore's
+    /// numerators and det.
+    #[inline(always)]
+    pub fn nearest(mask: u32, [t, u, v, det]: [f32x8; 4], t_max: f32) -> Option<Self> {
+        if mask == 0 {
+            return None;
+        }
+        let inv = f32x8::ONE / det;
+        let t = (t * inv).to_array();
+        let mut best: Option<usize> = None;
+        let mut bits = mask;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if t[i] < t_max && best.is_none_or(|b| t[i] < t[b]) {
+                best = Some(i);
+            }
+        }
+        let lane = best?;
+        let (u, v) = ((u * inv).to_array()[lane], (v * inv).to_array()[lane]);
+        Some(Self { lane, t: t[lane], u, v })
+    }
+}
+
 /// Eight rays' nearest hits so far, one per lane, as vectors: the distance (the ray's limit before any hit), the
 /// barycentrics and the triangle id (as f32 bits, for the blends; `u32::MAX` for none).
 #[derive(Clone, Copy, Debug)]
@@ -34,6 +59,22 @@ impl NearestLanes {
     #[inline(always)]
     pub fn new(t_max: f32) -> Self {
         Self { t: f32x8::splat(t_max), u: f32x8::ZERO, v: f32x8::ZERO, id: f32x8::splat(f32::from_bits(u32::MAX)) }
+    }
+
+    /// Keeps triangle `id`'s hits in the lanes of `hit` (all bits set) that are nearer than the lane's hit so far,
+    /// from Möller–Trumbore's numerators and det.
+    #[inline(always)]
+    pub fn keep_nearer(&mut self, hit: f32x8, [t, u, v, det]: [f32x8; 4], id: u32) {
+        if hit.none() {
+            return;
+        }
+        let inv = f32x8::ONE / det;
+        let t = t * inv;
+        let nearer = hit & t.cmp_lt(self.t);
+        self.t = nearer.blend(t, self.t);
+        self.u = nearer.blend(u * inv, self.u);
+        self.v = nearer.blend(v * inv, self.v);
+        self.id = nearer.blend(f32x8::splat(f32::from_bits(id)), self.id);
     }
 
     /// The hits found.
@@ -98,32 +139,15 @@ impl TrianglePacket {
     /// The nearest hit at `0 < t < t_max`.
     #[inline(always)]
     pub fn closest(&self, ray: &WideRay, t_max: f32) -> Option<LaneHit> {
-        let (mask, [t, u, v, det]) = self.test(ray, t_max);
-        if mask == 0 {
-            return None;
-        }
-        let inv = f32x8::ONE / det;
-        let t = (t * inv).to_array();
-        let mut best: Option<usize> = None;
-        let mut bits = mask;
-        while bits != 0 {
-            let i = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            if t[i] < t_max && best.is_none_or(|b| t[i] < t[b]) {
-                best = Some(i);
-            }
-        }
-        let lane = best?;
-        let (u, v) = ((u * inv).to_array()[lane], (v * inv).to_array()[lane]);
-        Some(LaneHit { lane, t: t[lane], u, v })
+        let (mask, tuvd) = self.test(ray, t_max);
+        LaneHit::nearest(mask, tuvd, t_max)
     }
 
     /// The triangle in lane `k` against eight rays `o + t·d`, one per lane: [`moller_trumbore`] with the roles of
     /// the lanes swapped.
     #[inline(always)]
     fn test_rays(&self, k: usize, o: &[f32x8; 3], d: &[f32x8; 3], t_max: f32x8) -> (f32x8, [f32x8; 4]) {
-        let splat = |v: &[f32x8; 3]| v.map(|axis| f32x8::splat(axis.as_array_ref()[k]));
-        moller_trumbore(&splat(&self.v0), &splat(&self.e1), &splat(&self.e2), o, d, t_max)
+        moller_trumbore(&lane_splat(&self.v0, k), &lane_splat(&self.e1, k), &lane_splat(&self.e2, k), o, d, t_max)
     }
 
     /// Each of eight rays `o + t·d` (one per lane; those in `active`, all bits set) keeps in `nearest` the nearer
@@ -134,18 +158,8 @@ impl TrianglePacket {
     pub fn nearer_of_rays(&self, o: &[f32x8; 3], d: &[f32x8; 3], active: f32x8, nearest: &mut NearestLanes) {
         let limit = nearest.t;
         for k in (0..8).filter(|&k| self.ids[k] != u32::MAX) {
-            let (hit, [t, u, v, det]) = self.test_rays(k, o, d, limit);
-            let hit = hit & active;
-            if hit.none() {
-                continue;
-            }
-            let inv = f32x8::ONE / det;
-            let t = t * inv;
-            let nearer = hit & t.cmp_lt(nearest.t);
-            nearest.t = nearer.blend(t, nearest.t);
-            nearest.u = nearer.blend(u * inv, nearest.u);
-            nearest.v = nearer.blend(v * inv, nearest.v);
-            nearest.id = nearer.blend(f32x8::splat(f32::from_bits(self.ids[k])), nearest.id);
+            let (hit, tuvd) = self.test_rays(k, o, d, limit);
+            nearest.keep_nearer(hit & active, tuvd, self.ids[k]);
         }
     }
 
@@ -180,9 +194,45 @@ impl TrianglePacket {
     }
 }
 
+/// Lane `k` of each of three vectors, in every lane: three broadcasts (through `map`, the compiler built the
+/// arrays on the stack and copied them).
+#[inline(always)]
+pub(super) fn lane_splat(v: &[f32x8; 3], k: usize) -> [f32x8; 3] {
+    let [x, y, z] = v;
+    let one = |v: &f32x8| f32x8::splat(v.as_array_ref()[k]);
+    [one(x), one(y), one(z)]
+}
+
+/// What Möller–Trumbore computes from a triangle and a ray's origin alone, per lane: `T = o − v₀`, `Q = T × e₁`
+/// and `e₂·Q` (det times the distance).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct OriginTerms {
+    t: [f32x8; 3],
+    q: [f32x8; 3],
+    e2q: f32x8,
+}
+
+impl OriginTerms {
+    #[inline(always)]
+    pub fn new(v0: &[f32x8; 3], e1: &[f32x8; 3], e2: &[f32x8; 3], o: &[f32x8; 3]) -> Self {
+        let [e1x, e1y, e1z] = *e1;
+        let [e2x, e2y, e2z] = *e2;
+        let (tx, ty, tz) = (o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]);
+        let (qx, qy, qz) = (ty.mul_sub(e1z, tz * e1y), tz.mul_sub(e1x, tx * e1z), tx.mul_sub(e1y, ty * e1x));
+        let e2q = e2x.mul_add(qx, e2y.mul_add(qy, e2z * qz));
+        Self { t: [tx, ty, tz], q: [qx, qy, qz], e2q }
+    }
+
+    /// Lane `k`'s terms in every lane.
+    #[inline(always)]
+    pub fn splat(&self, k: usize) -> Self {
+        let e2q = f32x8::splat(self.e2q.as_array_ref()[k]);
+        Self { t: lane_splat(&self.t, k), q: lane_splat(&self.q, k), e2q }
+    }
+}
+
 /// Möller–Trumbore on eight (triangle, ray) pairs, one per lane. Returns the lanes hit at `0 < t < t_max` (each
-/// lane's own limit; all bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane. The tests run on the numerators
-/// with det's sign folded in (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
+/// lane's own limit; all bits set), with `(T·P, d·Q, e₂·Q)` and det in every lane.
 #[inline(always)]
 fn moller_trumbore(
     v0: &[f32x8; 3],
@@ -192,16 +242,28 @@ fn moller_trumbore(
     d: &[f32x8; 3],
     t_max: f32x8,
 ) -> (f32x8, [f32x8; 4]) {
+    moller_trumbore_from(&OriginTerms::new(v0, e1, e2, o), e1, e2, d, t_max)
+}
+
+/// [`moller_trumbore`] with the terms of the triangles and the rays' origins worked out: the same operations on
+/// the same values, so the same answers bit for bit. The tests run on the numerators with det's sign folded in
+/// (`u ≥ 0` ⇔ `(T·P)·sgn(det) ≥ 0`, and so on), so no lane is divided until one is hit.
+#[inline(always)]
+pub(super) fn moller_trumbore_from(
+    origin: &OriginTerms,
+    e1: &[f32x8; 3],
+    e2: &[f32x8; 3],
+    d: &[f32x8; 3],
+    t_max: f32x8,
+) -> (f32x8, [f32x8; 4]) {
     let [dx, dy, dz] = *d;
     let [e1x, e1y, e1z] = *e1;
     let [e2x, e2y, e2z] = *e2;
     let (px, py, pz) = (dy.mul_sub(e2z, dz * e2y), dz.mul_sub(e2x, dx * e2z), dx.mul_sub(e2y, dy * e2x));
     let det = e1x.mul_add(px, e1y.mul_add(py, e1z * pz));
-    let (tx, ty, tz) = (o[0] - v0[0], o[1] - v0[1], o[2] - v0[2]);
-    let (qx, qy, qz) = (ty.mul_sub(e1z, tz * e1y), tz.mul_sub(e1x, tx * e1z), tx.mul_sub(e1y, ty * e1x));
+    let ([tx, ty, tz], [qx, qy, qz], t) = (origin.t, origin.q, origin.e2q);
     let u = tx.mul_add(px, ty.mul_add(py, tz * pz));
     let v = dx.mul_add(qx, dy.mul_add(qy, dz * qz));
-    let t = e2x.mul_add(qx, e2y.mul_add(qy, e2z * qz));
     let abs_det = det.abs();
     let (su, sv, st) = (u.flip_signs(det), v.flip_signs(det), t.flip_signs(det));
     let zero = f32x8::ZERO;
