@@ -248,19 +248,17 @@ pub fn estimate_emitter_lanes(
         // `Scene::emitted(Δ, −ω)`: ω leaves Δ on its emitting side, since cos θ_Δ = n_Δ·(−ω) > 0 in `ok`. Read
         // with the picks where they came from vectors; else one light material (a scene with one light) is
         // broadcast, several gathered.
-        let emission = |l: usize| scene.materials[e.light_material[l] as usize].emission;
         let lm = e.light_material[(light.trailing_zeros() & 7) as usize];
-        let one_light = light & !lanes_equal(&e.light_material, lm) == 0;
         let (li, lit) = if let Some(li) = e.light_emission {
             let zero = li.x.cmp_eq(f32x8::ZERO) & li.y.cmp_eq(f32x8::ZERO) & li.z.cmp_eq(f32x8::ZERO);
             (li, light & !(zero.move_mask() as u32))
-        } else if one_light {
+        } else if light & !lanes_equal(&e.light_material, lm) == 0 {
             let li = scene.materials[lm as usize].emission;
             (Vec3x8::splat(li), if li != Vec3::ZERO { light } else { 0 })
         } else {
             let (mut li, mut lit) = ([Vec3::ZERO; LANES], 0);
             for_each_lane(light, |l| {
-                li[l] = emission(l);
+                li[l] = scene.materials[e.light_material[l] as usize].emission;
                 lit |= ((li[l] != Vec3::ZERO) as u32) << l;
             });
             (Vec3x8::from_lanes(&li), lit)

@@ -2,7 +2,8 @@
 //! Möller–Trumbore's terms, `T = o − v₀`, `Q = T × e₁` and `e₂·Q` depend on the triangle and the origin alone
 //! ([`OriginTerms`]); they are worked out once per cone, with the operations the test itself runs, so each ray's
 //! test gives the numbers [`TrianglePacket`]'s gives, bit for bit, and costs the direction's terms only (`P`, det,
-//! `T·P`, `d·Q`): about a third fewer operations per triangle and ray.
+//! `T·P`, `d·Q`). With the broadcasts of `packet::lane_splat`, the Cornell box's `emitter` render took 315.5 M
+//! instructions instead of 334.3 M, the knot's 811.2 M instead of 835.4 M (callgrind, 128², 64 spp, one thread).
 
 use super::packet::{LaneHit, NearestLanes, OriginTerms, TrianglePacket, lane_splat, moller_trumbore_from};
 use glam::Vec3;
