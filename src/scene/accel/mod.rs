@@ -6,8 +6,8 @@
 //! camera rays also have their pixel's cone of candidate triangles (`frustum`), an exact cull, and where a pixel
 //! sees too many triangles for one, its camera rays walk the tree as one packet.
 
-#[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
 mod apex_packet;
+#[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
 mod avx512;
 mod blockers;
 mod build;
