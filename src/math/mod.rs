@@ -68,10 +68,20 @@ pub fn lanes_equal(values: &[u32; 8], value: u32) -> u32 {
     on.move_mask() as u32
 }
 
+/// The weights of [`luminance`].
+const LUMINANCE: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
 /// Luminance of a linear Rec. 709 / sRGB colour (ITU-R BT.709 weights).
 #[inline]
 pub fn luminance(c: glam::Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+    LUMINANCE[0] * c.x + LUMINANCE[1] * c.y + LUMINANCE[2] * c.z
+}
+
+/// [`luminance`] of eight colours, one per lane: the same products summed in the same order, bit for bit.
+#[inline(always)]
+pub fn luminance_lanes(c: &Vec3x8) -> wide::f32x8 {
+    use wide::f32x8;
+    f32x8::splat(LUMINANCE[0]) * c.x + f32x8::splat(LUMINANCE[1]) * c.y + f32x8::splat(LUMINANCE[2]) * c.z
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! average correctly, and their count; and the largest single sample, for the firefly map. Non-finite samples are
 //! never added: the pass counts them instead.
 
-use crate::math::{Vec3x8, luminance};
+use crate::math::{Vec3x8, luminance, luminance_lanes};
 use glam::{DVec3, Vec3};
 use wide::{CmpLt, f32x8, f64x4};
 
@@ -114,10 +114,8 @@ impl PixelSums {
         if finite & used != used {
             return self.add_finite(&v.to_lanes()[..n]);
         }
-        // `luminance` in each lane: the same products, summed in the same order.
-        let l = v.x * f32x8::splat(0.2126) + v.y * f32x8::splat(0.7152) + v.z * f32x8::splat(0.0722);
-        let l =
-            (f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32))).blend(l, f32x8::ZERO);
+        let lanes = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32));
+        let l = lanes.blend(luminance_lanes(v), f32x8::ZERO);
         let l = l.to_array();
         let half: [f32; 4] = std::array::from_fn(|i| brighter(l[i], l[i + 4]));
         self.max_luminance =
