@@ -136,8 +136,9 @@ impl Node8 {
 /// `inv_d` = 1/d. Returns the lanes whose box the ray overlaps for some `0 ≤ t ≤ t_max` and the distances at which
 /// it enters them; an empty box's lane (min = +∞, max = −∞) holds no answer, and callers leave it out. Per axis the
 /// nearer and farther of the two planes' distances are taken with a min and a max, which pick the same values as
-/// choosing the planes by the sign of d (the two differences keep their order through the rounded product) at a
-/// third of the operations of a blend each, and need no sign masks per ray. One ray against eight boxes
+/// choosing the planes by the sign of d (the two differences keep their order through the rounded product), with
+/// no variable blend and no sign masks per ray (the knot's `emitter` render: 854.3 M → 847.4 M instructions,
+/// callgrind, 128², 64 spp). One ray against eight boxes
 /// ([`Node8::intersect`]) and eight rays against one box ([`Node8::enter_lanes`]) run it alike, so their answers
 /// agree bit for bit.
 #[inline(always)]
