@@ -75,6 +75,13 @@ impl Vec3x8 {
         self * (f32x8::ONE / self.length())
     }
 
+    /// All bits set in the lanes that are not the zero vector (as `v != Vec3::ZERO`: −0 counts as 0).
+    #[inline(always)]
+    pub fn nonzero(&self) -> f32x8 {
+        use wide::CmpEq;
+        !(self.x.cmp_eq(f32x8::ZERO) & self.y.cmp_eq(f32x8::ZERO) & self.z.cmp_eq(f32x8::ZERO))
+    }
+
     /// `t` in the lanes where `mask` is set (all bits), `f` elsewhere.
     #[inline(always)]
     pub fn select(mask: f32x8, t: Self, f: Self) -> Self {

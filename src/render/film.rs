@@ -2,9 +2,9 @@
 //! average correctly, and their count; and the largest single sample, for the firefly map. Non-finite samples are
 //! never added: the pass counts them instead.
 
-use crate::math::{Vec3x8, luminance, luminance_lanes};
+use crate::math::{Vec3x8, lane_mask, luminance, luminance_lanes};
 use glam::{DVec3, Vec3};
-use wide::{CmpLt, f32x8, f64x4};
+use wide::{f32x8, f64x4};
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelAccum {
@@ -114,8 +114,7 @@ impl PixelSums {
         if finite & used != used {
             return self.add_finite(&v.to_lanes()[..n]);
         }
-        let lanes = f32x8::new([0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]).cmp_lt(f32x8::splat(n as f32));
-        let l = lanes.blend(luminance_lanes(v), f32x8::ZERO);
+        let l = bytemuck::cast::<_, f32x8>(lane_mask(used)).blend(luminance_lanes(v), f32x8::ZERO);
         let l = l.to_array();
         let half: [f32; 4] = std::array::from_fn(|i| brighter(l[i], l[i + 4]));
         self.max_luminance =

@@ -84,6 +84,13 @@ pub struct PickedFields {
     pub emission: Vec3x8,
 }
 
+/// Values per slot as vectors: value k of slot s in lane s of vector k, for the [`FieldTable`]'s slots (the lanes
+/// after the records' hold what `value` gives for them: [`EmitterTriangle::NONE`]'s).
+fn by_slot<const K: usize>(value: impl Fn(usize) -> [f32; K]) -> [f32x8; K] {
+    let slots: [[f32; K]; 8] = std::array::from_fn(value);
+    std::array::from_fn(|k| f32x8::new(slots.map(|v| v[k])))
+}
+
 /// An emitter triangle as light sampling reads it, with its p_Δ, in one aligned record (its first cache line
 /// holds what sampling reads, the second the offset bounds the shadow ray reads later): picking one costs one
 /// load after the alias table's, where going through the slot's triangle index and the scene's triangle list
@@ -171,16 +178,19 @@ impl EmitterSampler {
         };
         let small = !records.is_empty() && records.len() <= FIELD_TABLE_SLOTS;
         let table = distribution.steps().filter(|_| small).map(|steps| {
-            let rows = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).rows();
-            let field = |k: usize| f32x8::new(std::array::from_fn(|s| rows(s)[k / 8].as_array_ref()[k % 8]));
-            let error = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE).error;
-            let bound = |s: usize| {
-                [error(s).at_point, error(s).per_distance.x, error(s).per_distance.y, error(s).per_distance.z]
-            };
-            let errors = std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| bound(s)[k])));
-            let le = |s: usize| records.get(s).map_or(Vec3::ZERO, |r| scene.materials[r.material as usize].emission);
-            let emission = std::array::from_fn(|k| f32x8::new(std::array::from_fn(|s| le(s)[k])));
-            FieldTable { steps, fields: std::array::from_fn(field), errors, emission }
+            let record = |s: usize| records.get(s).unwrap_or(&EmitterTriangle::NONE);
+            let fields = by_slot(|s| {
+                let [low, high] = record(s).rows();
+                std::array::from_fn(|k| if k < 8 { low.as_array_ref()[k] } else { high.as_array_ref()[k - 8] })
+            });
+            let errors = by_slot(|s| {
+                let SurfaceError { at_point, per_distance: w } = record(s).error;
+                [at_point, w.x, w.y, w.z]
+            });
+            let emission = by_slot(|s| {
+                records.get(s).map_or(Vec3::ZERO, |r| scene.materials[r.material as usize].emission).to_array()
+            });
+            FieldTable { steps, fields, errors, emission }
         });
         Some(Self { selection, distribution, triangles: scene.emitters.clone(), slot_of, records, table })
     }

@@ -15,7 +15,7 @@ use crate::scene::{EmitterSampler, EmitterTriangle, HitLanes, PickedFields, Scen
 use bytemuck::cast;
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
-use wide::{CmpEq, CmpGt, CmpLt, f32x8, i32x8};
+use wide::{CmpGt, CmpLt, f32x8, i32x8};
 
 /// Emitter sampling's directions for up to eight lanes, before any ray is traced: each lane's shading point, the
 /// light triangle it picked and the point x on it, ω towards x and the density p(ω) = p_Δ ‖x − p‖² / (A_Δ |n_Δ·ω|),
@@ -250,8 +250,7 @@ pub fn estimate_emitter_lanes(
         // broadcast, several gathered.
         let lm = e.light_material[(light.trailing_zeros() & 7) as usize];
         let (li, lit) = if let Some(li) = e.light_emission {
-            let zero = li.x.cmp_eq(f32x8::ZERO) & li.y.cmp_eq(f32x8::ZERO) & li.z.cmp_eq(f32x8::ZERO);
-            (li, light & !(zero.move_mask() as u32))
+            (li, light & li.nonzero().move_mask() as u32)
         } else if light & !lanes_equal(&e.light_material, lm) == 0 {
             let li = scene.materials[lm as usize].emission;
             (Vec3x8::splat(li), if li != Vec3::ZERO { light } else { 0 })
@@ -342,9 +341,8 @@ pub fn estimate_mis_emitter_brdf_lanes(
     });
     let (f, li) = (Vec3x8::from_lanes(&kd) * f32x8::splat(FRAC_1_PI), Vec3x8::from_lanes(&li));
     let (cos, pdf) = (f32x8::new(e.cos), f32x8::new(e.pdf));
-    let nonzero = |v: Vec3x8| !(v.x.cmp_eq(f32x8::ZERO) & v.y.cmp_eq(f32x8::ZERO) & v.z.cmp_eq(f32x8::ZERO));
     let towards = e.n.dot(e.wo).cmp_gt(f32x8::ZERO);
-    let diffuse = (towards & nonzero(f) & nonzero(li)).move_mask() as u32 & light & !specular;
+    let diffuse = (towards & f.nonzero() & li.nonzero()).move_mask() as u32 & light & !specular;
     let w = heuristic.weight_lanes(pdf, cos.max(f32x8::ZERO) * f32x8::splat(FRAC_1_PI));
     let weighted = (f * li * cos * (w / (f32x8::ONE * pdf))).to_lanes();
     for_each_lane(diffuse, |l| first[l] = weighted[l]);
